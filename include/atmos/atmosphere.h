@@ -1,0 +1,80 @@
+// atmos: the parameters of a planet's atmosphere.
+//
+// Field names and the layered density profile follow seed 004 (Bruneton 2017,
+// "AtmosphereParameters" and "DensityProfileLayer"). All values are SI: metres,
+// per-metre coefficients, radians. The struct is trivially copyable so that it
+// can be passed by value to device code.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "atmos/math.h"
+
+namespace atmos {
+
+// One layer of a density profile (seed 004): the density at altitude h (metres
+// above bottom_radius) is
+//   clamp(exp_term * exp(exp_scale * h) + linear_term * h + constant_term, 0, 1)
+// Seed 004: layers[0] applies below layers[0].width (altitude from the ground),
+// layers[1] everywhere above.
+struct DensityProfileLayer {
+    double width = 0.0;          // m; the last layer's width is ignored
+    double exp_term = 0.0;       // dimensionless
+    double exp_scale = 0.0;      // 1/m (negative for a decaying profile: -1/H)
+    double linear_term = 0.0;    // 1/m
+    double constant_term = 0.0;  // dimensionless
+};
+
+// Seed 004's two-layer profile: layers[0] applies below layers[0].width,
+// layers[1] above. A single exponential uses layers[1] alone (layers[0] has
+// width 0).
+struct DensityProfile {
+    DensityProfileLayer layers[2];
+};
+
+struct AtmosphereParameters {
+    double bottom_radius = 6360e3;  // m: the planet's surface
+    double top_radius = 6460e3;     // m: where the atmosphere is taken to end
+    Vec3d rayleigh_scattering;      // 1/m at density 1 (Rayleigh: no absorption)
+    DensityProfile rayleigh_density;
+    Vec3d mie_scattering;  // 1/m at density 1
+    Vec3d mie_extinction;  // 1/m at density 1 (>= mie_scattering)
+    DensityProfile mie_density;
+    double mie_phase_g = 0.8;     // Cornette-Shanks asymmetry
+    Vec3d absorption_extinction;  // 1/m at density 1 (ozone: absorption only)
+    DensityProfile absorption_density;
+    Vec3d ground_albedo;                    // Lambertian, [0, 1]
+    double sun_angular_radius = 0.004675;   // rad
+    Vec3d solar_irradiance{1.0};            // per channel, top of atmosphere
+    double mu_s_min = -0.2079116908177593;  // cos(102 deg): lowest sun tables cover
+};
+
+// A profile made of one exponential with scale height `scale_height` (metres).
+DensityProfile ExponentialProfile(double scale_height);
+
+// The canonical `earth` of DESIGN.md, built in code (also shipped as
+// data/atmospheres/earth.json; a test checks that the two agree).
+AtmosphereParameters EarthAtmosphere();
+
+// Checks every field; throws atmos::Error naming the first invalid field and its
+// allowed range.
+void ValidateAtmosphere(const AtmosphereParameters& atmosphere);
+
+// Names of the presets shipped in data/atmospheres (without ".json").
+std::vector<std::string> AtmospherePresetNames();
+
+// Loads a preset by name ("earth", "earth-bruneton", ...) or a JSON file by path,
+// applies the overrides `FIELD=VALUE` in order (DESIGN.md: --set), validates and
+// returns it. Throws atmos::Error with one clear message on any problem.
+AtmosphereParameters LoadAtmosphere(const std::string& name_or_path,
+                                    const std::vector<std::string>& overrides = {});
+
+// Parses / serialises the JSON text of an atmosphere (the format of the preset
+// files). Parsing validates.
+AtmosphereParameters AtmosphereFromJson(const std::string& json_text,
+                                        const std::string& source_name = "<json>");
+std::string AtmosphereToJson(const AtmosphereParameters& atmosphere);
+
+}  // namespace atmos

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs the Debian packages atmos builds with (only those missing), then
+# configures and builds. Usage: scripts/setup.sh [--sanitize] [BUILD_DIR]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+sanitize=OFF
+build_dir=""
+for arg in "$@"; do
+    case "$arg" in
+        --sanitize) sanitize=ON ;;
+        *) build_dir="$arg" ;;
+    esac
+done
+if [ -z "$build_dir" ]; then
+    if [ "$sanitize" = ON ]; then build_dir=build-asan; else build_dir=build; fi
+fi
+
+packages=(cmake g++ make ninja-build pkg-config libopenexr-dev libpng-dev nlohmann-json3-dev
+          libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev clang-format)
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+    echo "atmos setup: installing ${missing[*]}" >&2
+    SUDO=""
+    if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; fi
+    export DEBIAN_FRONTEND=noninteractive
+    $SUDO apt-get update -qq
+    $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+werror=OFF
+if [ -n "${CI:-}" ]; then werror=ON; fi
+build_type=Release
+if [ "$sanitize" = ON ]; then build_type=RelWithDebInfo; fi
+cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" \
+      -DATMOS_WERROR="$werror" -DATMOS_SANITIZE="$sanitize" >/dev/null
+cmake --build "$build_dir" -j "$(nproc)"

@@ -1,0 +1,40 @@
+// atmos: CUDA kernels over the one per-pixel function, ShadePixel().
+//
+// Compiled by nvcc from the same headers as the CPU build (render/render.h and
+// the models' evaluators); built for the architectures of ATMOS_CUDA_ARCHITECTURES.
+#include <cuda_runtime.h>
+
+#include "models/empty.h"
+#include "models/naive.h"
+#include "render/render.h"
+
+namespace atmos {
+namespace cuda {
+
+template <typename Evaluator>
+__global__ void RenderKernel(Evaluator evaluator, PixelSetup setup, ImageView out) {
+    const int x = static_cast<int>(blockIdx.x * blockDim.x + threadIdx.x);
+    const int y = static_cast<int>(blockIdx.y * blockDim.y + threadIdx.y);
+    if (x >= setup.width || y >= setup.height) return;
+    out.Set(x, y, ShadePixel(evaluator, setup, x, y));
+}
+
+// Renders into device memory `device_pixels` (width * height * 3 floats).
+// Returns the CUDA error of the launch.
+template <typename Evaluator>
+cudaError_t LaunchRender(const Evaluator& evaluator, const PixelSetup& setup, float* device_pixels,
+                         cudaStream_t stream) {
+    const dim3 block(16, 16);
+    const dim3 grid((setup.width + block.x - 1) / block.x, (setup.height + block.y - 1) / block.y);
+    ImageView view{device_pixels, setup.width, setup.height};
+    RenderKernel<<<grid, block, 0, stream>>>(evaluator, setup, view);
+    return cudaGetLastError();
+}
+
+template cudaError_t LaunchRender<EmptyEvaluator>(const EmptyEvaluator&, const PixelSetup&, float*,
+                                                  cudaStream_t);
+template cudaError_t LaunchRender<NaiveEvaluator>(const NaiveEvaluator&, const PixelSetup&, float*,
+                                                  cudaStream_t);
+
+}  // namespace cuda
+}  // namespace atmos

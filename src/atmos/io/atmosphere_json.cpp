@@ -1,0 +1,510 @@
+// atmos: atmosphere parameter files (JSON), the embedded presets and --set overrides.
+//
+// Format (DESIGN.md "Canonical parameters"): one JSON object whose keys are the
+// field names of AtmosphereParameters (SI units), plus optional "name" and
+// "description" strings. RGB fields take a number or an array of 3 numbers.
+// Density fields take one of
+//   {"layers": [LAYER] or [LAYER, LAYER]}   seed 004's DensityProfileLayer list; a
+//       LAYER is an object with any of width, exp_term, exp_scale, linear_term,
+//       constant_term (missing ones are 0); one layer goes to layers[1] (the
+//       profile's layers[0] then has width 0 and never applies);
+//   {"scale_height": H}                      exp(-h / H);
+//   {"tent": {"center": c, "half_width": w}} 1 at c, falling linearly to 0 at c -/+ w.
+// Every field is required except mu_s_min (default cos(102 deg), seed 004's demo).
+// Unknown keys are errors (they are usually typos).
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "atmos/atmosphere.h"
+#include "atmos/embedded_presets.h"
+#include "atmos/error.h"
+
+namespace atmos {
+
+namespace {
+
+// Keeps the keys in file order, so a written file reads like the presets.
+using Json = nlohmann::ordered_json;
+
+enum class FieldKind { kScalar, kRgb, kDensity };
+
+struct FieldSpec {
+    const char* name;
+    FieldKind kind;
+};
+
+// The fields in the order of AtmosphereParameters (and of the files we write).
+constexpr FieldSpec kFields[] = {
+    {"bottom_radius", FieldKind::kScalar},      {"top_radius", FieldKind::kScalar},
+    {"rayleigh_scattering", FieldKind::kRgb},   {"rayleigh_density", FieldKind::kDensity},
+    {"mie_scattering", FieldKind::kRgb},        {"mie_extinction", FieldKind::kRgb},
+    {"mie_density", FieldKind::kDensity},       {"mie_phase_g", FieldKind::kScalar},
+    {"absorption_extinction", FieldKind::kRgb}, {"absorption_density", FieldKind::kDensity},
+    {"ground_albedo", FieldKind::kRgb},         {"sun_angular_radius", FieldKind::kScalar},
+    {"solar_irradiance", FieldKind::kRgb},      {"mu_s_min", FieldKind::kScalar},
+};
+
+constexpr const char* kLayerKeys[] = {"width", "exp_term", "exp_scale", "linear_term",
+                                      "constant_term"};
+
+const char kDensityForms[] =
+    "a density is {\"layers\": [...]}, {\"scale_height\": H} or "
+    "{\"tent\": {\"center\": c, \"half_width\": w}}";
+
+// Seed 004's demo: max_sun_zenith_angle = 102 degrees.
+double DefaultMuSMin() { return std::cos(102.0 / 180.0 * kPi); }
+
+const FieldSpec* FindField(const std::string& name) {
+    for (const FieldSpec& spec : kFields) {
+        if (name == spec.name) return &spec;
+    }
+    return nullptr;
+}
+
+std::string FieldList() {
+    std::string list;
+    for (const FieldSpec& spec : kFields) {
+        if (!list.empty()) list += ", ";
+        list += spec.name;
+    }
+    return list;
+}
+
+std::string Join(const std::vector<std::string>& items, const std::string& separator) {
+    std::string joined;
+    for (size_t i = 0; i < items.size(); ++i) {
+        if (i > 0) joined += separator;
+        joined += items[i];
+    }
+    return joined;
+}
+
+bool IsLayerKey(const std::string& key) {
+    return std::any_of(std::begin(kLayerKeys), std::end(kLayerKeys),
+                       [&](const char* k) { return key == k; });
+}
+
+// nlohmann's messages start with "[json.exception.parse_error.101] "; keep the rest.
+std::string JsonMessage(const nlohmann::json::exception& e) {
+    std::string message = e.what();
+    if (!message.empty() && message[0] == '[') {
+        const size_t end = message.find("] ");
+        if (end != std::string::npos) message = message.substr(end + 2);
+    }
+    return message;
+}
+
+// ---------------------------------------------------------------------------------------
+// Reading the tree. `where` is the message prefix, e.g. "atmosphere 'earth'".
+
+double ReadNumber(const Json& node, const std::string& where, const std::string& path) {
+    if (!node.is_number()) Fail(where, ": field '", path, "' must be a number");
+    return node.get<double>();
+}
+
+Vec3d ReadRgb(const Json& node, const std::string& where, const std::string& path) {
+    if (node.is_number()) return Vec3d(node.get<double>());
+    if (node.is_array() && node.size() == 3 &&
+        std::all_of(node.begin(), node.end(), [](const Json& v) { return v.is_number(); })) {
+        return Vec3d(node[0].get<double>(), node[1].get<double>(), node[2].get<double>());
+    }
+    Fail(where, ": field '", path, "' must be a number or an array of 3 numbers");
+}
+
+DensityProfileLayer ReadLayer(const Json& node, const std::string& where, const std::string& path) {
+    if (!node.is_object()) Fail(where, ": field '", path, "' must be an object");
+    for (const auto& item : node.items()) {
+        if (!IsLayerKey(item.key())) {
+            Fail(where, ": unknown field '", path, ".", item.key(),
+                 "' (a layer has width, exp_term, exp_scale, linear_term, constant_term)");
+        }
+    }
+    DensityProfileLayer layer;
+    double* const values[] = {&layer.width, &layer.exp_term, &layer.exp_scale, &layer.linear_term,
+                              &layer.constant_term};
+    for (size_t i = 0; i < std::size(kLayerKeys); ++i) {
+        const auto it = node.find(kLayerKeys[i]);
+        if (it != node.end()) *values[i] = ReadNumber(*it, where, path + "." + kLayerKeys[i]);
+    }
+    return layer;
+}
+
+DensityProfile ReadDensity(const Json& node, const std::string& where, const std::string& path) {
+    if (!node.is_object() || node.size() != 1) {
+        Fail(where, ": field '", path, "' must be an object with exactly one key (", kDensityForms,
+             ")");
+    }
+    const std::string key = node.begin().key();
+    const Json& value = node.begin().value();
+    if (key == "scale_height") {
+        const double scale_height = ReadNumber(value, where, path + ".scale_height");
+        if (!(scale_height > 0.0) || !std::isfinite(scale_height)) {
+            Fail(where, ": field '", path, ".scale_height' must be a finite number > 0 (m)");
+        }
+        return ExponentialProfile(scale_height);
+    }
+    if (key == "tent") {
+        if (!value.is_object()) Fail(where, ": field '", path, ".tent' must be an object");
+        for (const auto& item : value.items()) {
+            if (item.key() != "center" && item.key() != "half_width") {
+                Fail(where, ": unknown field '", path, ".tent.", item.key(),
+                     "' (a tent has center and half_width)");
+            }
+        }
+        for (const char* required : {"center", "half_width"}) {
+            if (!value.contains(required)) {
+                Fail(where, ": field '", path, ".tent.", required, "' is missing");
+            }
+        }
+        const double center = ReadNumber(value["center"], where, path + ".tent.center");
+        const double half_width = ReadNumber(value["half_width"], where, path + ".tent.half_width");
+        if (!(center >= 0.0) || !std::isfinite(center)) {
+            Fail(where, ": field '", path, ".tent.center' must be a finite number >= 0 (m)");
+        }
+        if (!(half_width > 0.0) || !std::isfinite(half_width)) {
+            Fail(where, ": field '", path, ".tent.half_width' must be a finite number > 0 (m)");
+        }
+        // Below the centre: (h - c + w) / w; above: (c + w - h) / w (seed 004's
+        // clamp to [0, 1] cuts both ends). The constant terms are written as one
+        // division each so that the canonical ozone layer (c = 25 km, w = 15 km)
+        // gives exactly -2/3 and 8/3.
+        DensityProfile profile;
+        profile.layers[0].width = center;
+        profile.layers[0].linear_term = 1.0 / half_width;
+        profile.layers[0].constant_term = (half_width - center) / half_width;
+        profile.layers[1].linear_term = -1.0 / half_width;
+        profile.layers[1].constant_term = (half_width + center) / half_width;
+        return profile;
+    }
+    if (key == "layers") {
+        if (!value.is_array() || value.empty() || value.size() > 2) {
+            Fail(where, ": field '", path, ".layers' must be an array of 1 or 2 layers");
+        }
+        DensityProfile profile;
+        if (value.size() == 1) {
+            profile.layers[1] = ReadLayer(value[0], where, path + ".layers[0]");
+        } else {
+            profile.layers[0] = ReadLayer(value[0], where, path + ".layers[0]");
+            profile.layers[1] = ReadLayer(value[1], where, path + ".layers[1]");
+        }
+        return profile;
+    }
+    Fail(where, ": unknown field '", path, ".", key, "' (", kDensityForms, ")");
+}
+
+AtmosphereParameters ReadTree(const Json& root, const std::string& where) {
+    if (!root.is_object()) Fail(where, ": the top level must be a JSON object");
+    for (const auto& item : root.items()) {
+        const std::string& key = item.key();
+        if (key == "name" || key == "description") {
+            if (!item.value().is_string()) Fail(where, ": field '", key, "' must be a string");
+            continue;
+        }
+        if (FindField(key) == nullptr) {
+            Fail(where, ": unknown field '", key, "' (fields: ", FieldList(),
+                 ", and the optional name, description)");
+        }
+    }
+    for (const FieldSpec& spec : kFields) {
+        if (!root.contains(spec.name) && std::string(spec.name) != "mu_s_min") {
+            Fail(where, ": field '", spec.name, "' is missing");
+        }
+    }
+
+    AtmosphereParameters a;
+    a.bottom_radius = ReadNumber(root["bottom_radius"], where, "bottom_radius");
+    a.top_radius = ReadNumber(root["top_radius"], where, "top_radius");
+    a.rayleigh_scattering = ReadRgb(root["rayleigh_scattering"], where, "rayleigh_scattering");
+    a.rayleigh_density = ReadDensity(root["rayleigh_density"], where, "rayleigh_density");
+    a.mie_scattering = ReadRgb(root["mie_scattering"], where, "mie_scattering");
+    a.mie_extinction = ReadRgb(root["mie_extinction"], where, "mie_extinction");
+    a.mie_density = ReadDensity(root["mie_density"], where, "mie_density");
+    a.mie_phase_g = ReadNumber(root["mie_phase_g"], where, "mie_phase_g");
+    a.absorption_extinction =
+        ReadRgb(root["absorption_extinction"], where, "absorption_extinction");
+    a.absorption_density = ReadDensity(root["absorption_density"], where, "absorption_density");
+    a.ground_albedo = ReadRgb(root["ground_albedo"], where, "ground_albedo");
+    a.sun_angular_radius = ReadNumber(root["sun_angular_radius"], where, "sun_angular_radius");
+    a.solar_irradiance = ReadRgb(root["solar_irradiance"], where, "solar_irradiance");
+    a.mu_s_min = root.contains("mu_s_min") ? ReadNumber(root["mu_s_min"], where, "mu_s_min")
+                                           : DefaultMuSMin();
+    try {
+        ValidateAtmosphere(a);
+    } catch (const Error& e) {
+        Fail(where, ": ", e.what());
+    }
+    return a;
+}
+
+Json ParseText(const std::string& text, const std::string& source_name) {
+    try {
+        return Json::parse(text);
+    } catch (const nlohmann::json::parse_error& e) {
+        Fail("atmosphere '", source_name, "': JSON syntax error: ", JsonMessage(e));
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Writing.
+
+Json RgbToJson(const Vec3d& v) { return Json::array({v.x, v.y, v.z}); }
+
+Json LayerToJson(const DensityProfileLayer& layer) {
+    Json node = Json::object();
+    node["width"] = layer.width;
+    node["exp_term"] = layer.exp_term;
+    node["exp_scale"] = layer.exp_scale;
+    node["linear_term"] = layer.linear_term;
+    node["constant_term"] = layer.constant_term;
+    return node;
+}
+
+Json DensityToJson(const DensityProfile& profile) {
+    Json node = Json::object();
+    node["layers"] = Json::array({LayerToJson(profile.layers[0]), LayerToJson(profile.layers[1])});
+    return node;
+}
+
+// ---------------------------------------------------------------------------------------
+// --set FIELD=VALUE.
+
+std::string Trim(const std::string& s) {
+    const size_t begin = s.find_first_not_of(" \t");
+    if (begin == std::string::npos) return "";
+    const size_t end = s.find_last_not_of(" \t");
+    return s.substr(begin, end - begin + 1);
+}
+
+std::vector<std::string> Split(const std::string& s, char separator) {
+    std::vector<std::string> parts;
+    size_t begin = 0;
+    while (true) {
+        const size_t end = s.find(separator, begin);
+        parts.push_back(
+            s.substr(begin, end == std::string::npos ? std::string::npos : end - begin));
+        if (end == std::string::npos) break;
+        begin = end + 1;
+    }
+    return parts;
+}
+
+// VALUE is JSON when it parses as JSON, else a comma-separated list of finite
+// numbers (one number -> a number, several -> an array).
+Json ParseOverrideValue(const std::string& value_text, const std::string& override_text) {
+    if (Trim(value_text).empty()) Fail("--set ", override_text, ": the value is empty");
+    Json parsed = Json::parse(value_text, nullptr, /*allow_exceptions=*/false);
+    if (!parsed.is_discarded()) return parsed;
+    Json numbers = Json::array();
+    for (const std::string& raw : Split(value_text, ',')) {
+        std::string item = Trim(raw);
+        if (!item.empty() && item[0] == '+') item = item.substr(1);
+        double number = 0.0;
+        const char* first = item.data();
+        const char* last = item.data() + item.size();
+        const auto result = std::from_chars(first, last, number);
+        if (result.ec == std::errc::result_out_of_range) {
+            Fail("--set ", override_text, ": '", Trim(raw), "' is out of the range of a double");
+        }
+        if (item.empty() || result.ec != std::errc() || result.ptr != last) {
+            Fail("--set ", override_text, ": '", Trim(raw),
+                 "' is not a number (VALUE is JSON or a comma-separated list of numbers)");
+        }
+        if (!std::isfinite(number)) {
+            Fail("--set ", override_text, ": '", Trim(raw), "' is not a finite number");
+        }
+        numbers.push_back(number);
+    }
+    if (numbers.size() == 1) return numbers[0];
+    return numbers;
+}
+
+bool ParseIndex(const std::string& text, int count, int* index) {
+    if (text.size() != 1 || text[0] < '0' || text[0] >= '0' + count) return false;
+    *index = text[0] - '0';
+    return true;
+}
+
+[[noreturn]] void FailUnknownField(const std::string& field, const std::string& text,
+                                   const std::string& hint) {
+    Fail("unknown atmosphere field '", field, "' in --set ", text, " (fields: ", FieldList(), hint,
+         ")");
+}
+
+void ApplyOverride(Json& root, const std::string& text, const std::string& where) {
+    const size_t eq = text.find('=');
+    if (eq == std::string::npos) {
+        Fail("--set '", text,
+             "': expected FIELD=VALUE, e.g. --set ground_albedo=0.3 (fields: ", FieldList(), ")");
+    }
+    const std::string field = text.substr(0, eq);
+    const std::vector<std::string> path = Split(field, '.');
+    const FieldSpec* spec = FindField(path[0]);
+    if (spec == nullptr) FailUnknownField(field, text, "");
+    const Json value = ParseOverrideValue(text.substr(eq + 1), text);
+    Json& node = root[path[0]];
+    if (path.size() == 1) {
+        node = value;
+        return;
+    }
+    if (spec->kind == FieldKind::kScalar) FailUnknownField(field, text, "");
+    if (spec->kind == FieldKind::kRgb) {
+        int channel = 0;
+        if (path.size() != 2 || !ParseIndex(path[1], 3, &channel)) {
+            FailUnknownField(
+                field, text,
+                "; an RGB field takes FIELD=v, FIELD=r,g,b or FIELD.I=v with I in 0..2");
+        }
+        if (node.is_number()) node = Json::array({node, node, node});
+        if (!node.is_array() || node.size() != 3) {
+            Fail("--set ", text, ": field '", path[0], "' is not a number or an array of 3");
+        }
+        node[static_cast<size_t>(channel)] = value;
+        return;
+    }
+    // A density profile.
+    const char density_hint[] =
+        "; a density takes FIELD.scale_height, FIELD.tent.center, FIELD.tent.half_width or "
+        "FIELD.layers.I.KEY with I in 0..1 and KEY one of width, exp_term, exp_scale, "
+        "linear_term, constant_term";
+    const std::string& form = path[1];
+    if (form == "scale_height" && path.size() == 2) {
+        node = Json::object({{"scale_height", value}});
+        return;
+    }
+    if (form == "tent" && path.size() == 2) {
+        node = Json::object({{"tent", value}});
+        return;
+    }
+    if (form == "tent" && path.size() == 3 && (path[2] == "center" || path[2] == "half_width")) {
+        const bool is_tent = node.is_object() && node.size() == 1 && node.contains("tent") &&
+                             node["tent"].is_object();
+        if (!is_tent) node = Json::object({{"tent", Json::object()}});
+        node["tent"][path[2]] = value;
+        return;
+    }
+    if (form == "layers") {
+        // Rewrite the profile in the two-layer form of DensityProfile first, so that
+        // layer indices mean the same whatever form the file used.
+        const DensityProfile current =
+            node.is_null() ? DensityProfile{} : ReadDensity(node, where, path[0]);
+        node = DensityToJson(current);
+        Json& layers = node["layers"];
+        int index = 0;
+        if (path.size() == 2) {
+            layers = value;
+            return;
+        }
+        if (ParseIndex(path[2], 2, &index)) {
+            if (path.size() == 3) {
+                layers[static_cast<size_t>(index)] = value;
+                return;
+            }
+            if (path.size() == 4 && IsLayerKey(path[3])) {
+                layers[static_cast<size_t>(index)][path[3]] = value;
+                return;
+            }
+        }
+    }
+    FailUnknownField(field, text, density_hint);
+}
+
+}  // namespace
+
+AtmosphereParameters AtmosphereFromJson(const std::string& json_text,
+                                        const std::string& source_name) {
+    const Json root = ParseText(json_text, source_name);
+    return ReadTree(root, "atmosphere '" + source_name + "'");
+}
+
+std::string AtmosphereToJson(const AtmosphereParameters& a) {
+    Json root = Json::object();
+    root["bottom_radius"] = a.bottom_radius;
+    root["top_radius"] = a.top_radius;
+    root["rayleigh_scattering"] = RgbToJson(a.rayleigh_scattering);
+    root["rayleigh_density"] = DensityToJson(a.rayleigh_density);
+    root["mie_scattering"] = RgbToJson(a.mie_scattering);
+    root["mie_extinction"] = RgbToJson(a.mie_extinction);
+    root["mie_density"] = DensityToJson(a.mie_density);
+    root["mie_phase_g"] = a.mie_phase_g;
+    root["absorption_extinction"] = RgbToJson(a.absorption_extinction);
+    root["absorption_density"] = DensityToJson(a.absorption_density);
+    root["ground_albedo"] = RgbToJson(a.ground_albedo);
+    root["sun_angular_radius"] = a.sun_angular_radius;
+    root["solar_irradiance"] = RgbToJson(a.solar_irradiance);
+    root["mu_s_min"] = a.mu_s_min;
+    // One field a line, one layer a line. nlohmann writes doubles with the
+    // shortest digits that read back exactly.
+    std::string text = "{\n";
+    bool first = true;
+    for (const auto& item : root.items()) {
+        if (!first) text += ",\n";
+        first = false;
+        text += "  " + Json(item.key()).dump() + ": ";
+        const Json& value = item.value();
+        if (value.is_object() && value.contains("layers")) {
+            text += "{\"layers\": [\n    " + value["layers"][0].dump() + ",\n    " +
+                    value["layers"][1].dump() + "\n  ]}";
+        } else {
+            text += value.dump();
+        }
+    }
+    return text + "\n}\n";
+}
+
+std::vector<std::string> AtmospherePresetNames() {
+    std::vector<std::string> names;
+    for (int i = 0; i < detail::kEmbeddedPresetCount; ++i) {
+        names.emplace_back(detail::kEmbeddedPresets[i].name);
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+AtmosphereParameters LoadAtmosphere(const std::string& name_or_path,
+                                    const std::vector<std::string>& overrides) {
+    std::string text;
+    bool found = false;
+    for (int i = 0; i < detail::kEmbeddedPresetCount; ++i) {
+        if (name_or_path == detail::kEmbeddedPresets[i].name) {
+            text = detail::kEmbeddedPresets[i].json;
+            found = true;
+            break;
+        }
+    }
+    if (!found) {
+        std::error_code ec;
+        if (!std::filesystem::exists(name_or_path, ec)) {
+            Fail("unknown atmosphere '", name_or_path, "': not a preset (",
+                 Join(AtmospherePresetNames(), ", "), ") and not a readable file");
+        }
+        std::ifstream in(name_or_path, std::ios::binary);
+        if (!std::filesystem::is_regular_file(name_or_path, ec) || !in) {
+            Fail("atmosphere '", name_or_path, "': cannot read the file");
+        }
+        in.seekg(0, std::ios::end);
+        const std::streamoff size = in.tellg();
+        in.seekg(0, std::ios::beg);
+        if (size < 0) Fail("atmosphere '", name_or_path, "': cannot read the file");
+        text.resize(static_cast<size_t>(size));
+        if (!in.read(text.data(), size)) {
+            Fail("atmosphere '", name_or_path, "': cannot read the file");
+        }
+    }
+    Json root = ParseText(text, name_or_path);
+    const std::string where = "atmosphere '" + name_or_path + "'";
+    if (!root.is_object()) Fail(where, ": the top level must be a JSON object");
+    for (const std::string& override_text : overrides) {
+        ApplyOverride(root, override_text, where);
+    }
+    if (overrides.empty()) return ReadTree(root, where);
+    return ReadTree(root, where + " (with --set " + Join(overrides, " --set ") + ")");
+}
+
+}  // namespace atmos

@@ -1,0 +1,37 @@
+// atmos model `empty`: a constant white sky.
+//
+// Source: seed 003 section 11.2.1 (the "empty shader"): it does no physics and
+// measures the overhead of the render loop itself. Output: sky radiance 1 per
+// unit solar irradiance for every ray (so a render shows the view's irradiance),
+// transmittance 1. Valid: it is not a model of anything; it is a baseline.
+#pragma once
+
+#include "atmos/model.h"
+#include "render/render.h"
+
+namespace atmos {
+
+struct EmptyEvaluator {
+    ATMOS_HD RayResult Evaluate(const Vec3d&, const Vec3d&, const Vec3d&, bool) const {
+        RayResult r;
+        r.sky = Rgb(1.0f);
+        r.transmittance = Rgb(1.0f);
+        return r;
+    }
+};
+
+class EmptyModel : public EvaluatorModel<EmptyModel> {
+  public:
+    explicit EmptyModel(const ModelOptions&) : info_(StaticInfo()), atm_(EarthAtmosphere()) {}
+    static ModelInfo StaticInfo();
+    const ModelInfo& Info() const override { return info_; }
+    void Prepare(const AtmosphereParameters& atmosphere) override { atm_ = atmosphere; }
+    EmptyEvaluator MakeEvaluator() const { return {}; }
+    const AtmosphereParameters& atmosphere() const { return atm_; }
+
+  private:
+    ModelInfo info_;
+    AtmosphereParameters atm_;
+};
+
+}  // namespace atmos

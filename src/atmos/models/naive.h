@@ -1,0 +1,122 @@
+// atmos model `naive`: single scattering by direct numerical integration.
+//
+// Source: Nishita et al. 1993, "Display of the Earth taking into account
+// atmospheric scattering", as formulated by Terrell 2016 (glsl-atmosphere) and
+// used by seed 003 section 11.2.6 (the thesis's "naive" model, with ozone
+// absorption added); equations of seed 003 section 3.2 (Eq. 1, 4, 8, 9).
+//
+// Implements: for the part of the view ray inside the atmosphere, split into
+// `steps` equal segments and sampled at their midpoints x_i,
+//   L = sum_i [ beta_R rho_R(x_i) P_R(nu) + beta_M rho_M(x_i) P_M(nu) ]
+//             T(camera, x_i) T_sun(x_i) ds
+// with T = exp(-tau) over Rayleigh scattering, Mie extinction and ozone
+// absorption (seed 004's layered profiles), T(camera, x_i) from the optical
+// depth accumulated along the view ray up to the midpoint, and T_sun(x_i) from
+// `light_steps` midpoint samples of the light ray to the top of the atmosphere.
+// A light ray that hits the ground contributes nothing (the planet's shadow).
+// Phases: Rayleigh 3/(16 pi)(1+nu^2), Cornette-Shanks for Mie.
+//
+// Output: radiance per unit solar irradiance (1/sr), transmittance of the
+// segment. Ground (albedo a): a/pi max(0, n.s) T_sun T_view, the direct sun only
+// (no sky light: a single-scattering model has none).
+//
+// Valid: anywhere, any sun; error shrinks with steps (tests/naive_test.cpp).
+// Deviations from Terrell: the view optical depth is taken to each sample's
+// midpoint (Terrell adds the whole step first), the planet's shadow is tested
+// (Terrell has none), cameras in space start where the ray enters the
+// atmosphere, and everything runs in double.
+#pragma once
+
+#include "atmos/atmosphere.h"
+#include "atmos/model.h"
+#include "physics/density.h"
+#include "physics/geometry.h"
+#include "physics/phase.h"
+#include "render/render.h"
+
+namespace atmos {
+
+struct NaiveEvaluator {
+    AtmosphereParameters atm;
+    int steps = 16;       // primary (view) ray samples
+    int light_steps = 8;  // light ray samples
+
+    // Optical depth (per channel) from `p` to the top of the atmosphere toward
+    // the sun, or false if that ray hits the ground.
+    ATMOS_HD bool SunOpticalDepth(const Vec3d& p, const Vec3d& sun, Vec3d* tau) const {
+        const double r = Length(p);
+        const double mu_s = ClampCosine(Dot(p, sun) / r);
+        if (RayIntersectsGround(r, mu_s, atm.bottom_radius)) return false;
+        const double length = DistanceToTopAtmosphereBoundary(r, mu_s, atm.top_radius);
+        const double ds = length / light_steps;
+        Vec3d sum;
+        for (int j = 0; j < light_steps; ++j) {
+            const Vec3d q = p + sun * ((j + 0.5) * ds);
+            sum += Extinction(atm, GetDensities(atm, Length(q) - atm.bottom_radius));
+        }
+        *tau = sum * ds;
+        return true;
+    }
+
+    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                                bool want_ground) const {
+        RayResult out;
+        out.transmittance = Rgb(1.0f);
+        const AtmosphereSegment seg =
+            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
+        out.hits_ground = seg.hits_ground;
+        if (!seg.inside) {
+            if (seg.hits_ground) out.transmittance = Rgb(1.0f);  // zero-length segment
+            return out;
+        }
+        const double ds = (seg.t_end - seg.t_start) / steps;
+        const double nu = Dot(dir, sun);
+        const double phase_r = RayleighPhase(nu);
+        const double phase_m = CornetteShanksPhase(atm.mie_phase_g, nu);
+        Vec3d tau_view;  // camera to the start of the current step
+        Vec3d sum_r, sum_m;
+        for (int i = 0; i < steps; ++i) {
+            const Vec3d p = camera + dir * (seg.t_start + (i + 0.5) * ds);
+            const Densities d = GetDensities(atm, Length(p) - atm.bottom_radius);
+            const Vec3d ext = Extinction(atm, d);
+            const Vec3d tau_mid = tau_view + ext * (0.5 * ds);
+            tau_view += ext * ds;
+            Vec3d tau_sun;
+            if (!SunOpticalDepth(p, sun, &tau_sun)) continue;
+            const Vec3d t = Exp(-(tau_mid + tau_sun));
+            sum_r += t * (d.rayleigh * ds);
+            sum_m += t * (d.mie * ds);
+        }
+        const Vec3d sky =
+            atm.rayleigh_scattering * sum_r * phase_r + atm.mie_scattering * sum_m * phase_m;
+        const Vec3d t_view = Exp(-tau_view);
+        out.sky = Rgb(sky);
+        out.transmittance = Rgb(t_view);
+        if (want_ground && seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0) {
+            const Vec3d g = camera + dir * seg.t_end;
+            const Vec3d n = Normalize(g);
+            const double cos_sun = Dot(n, sun);
+            Vec3d tau_sun;
+            if (cos_sun > 0.0 && SunOpticalDepth(g, sun, &tau_sun)) {
+                out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * Exp(-tau_sun) * t_view);
+            }
+        }
+        return out;
+    }
+};
+
+class NaiveModel : public EvaluatorModel<NaiveModel> {
+  public:
+    explicit NaiveModel(const ModelOptions& options);
+    static ModelInfo StaticInfo();
+    const ModelInfo& Info() const override { return info_; }
+    void Prepare(const AtmosphereParameters& atmosphere) override { evaluator_.atm = atmosphere; }
+    NaiveEvaluator MakeEvaluator() const { return evaluator_; }
+    const AtmosphereParameters& atmosphere() const { return evaluator_.atm; }
+
+  private:
+    ModelInfo info_;
+    NaiveEvaluator evaluator_;
+};
+
+}  // namespace atmos

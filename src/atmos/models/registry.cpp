@@ -1,0 +1,76 @@
+// atmos: THE list of models. Adding a model = one entry here.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "atmos/error.h"
+#include "atmos/model.h"
+#include "models/empty.h"
+#include "models/naive.h"
+
+namespace atmos {
+
+namespace {
+
+struct Entry {
+    std::function<ModelInfo()> info;
+    std::function<std::unique_ptr<Model>(const ModelOptions&)> create;
+};
+
+template <typename M>
+Entry MakeEntry() {
+    return {[] { return M::StaticInfo(); },
+            [](const ModelOptions& o) { return std::unique_ptr<Model>(new M(o)); }};
+}
+
+const std::vector<Entry>& Registry() {
+    static const std::vector<Entry> entries = {
+        MakeEntry<EmptyModel>(),
+        MakeEntry<NaiveModel>(),
+    };
+    return entries;
+}
+
+const std::vector<ModelInfo>& Infos() {
+    static const std::vector<ModelInfo> infos = [] {
+        std::vector<ModelInfo> v;
+        for (const Entry& e : Registry()) v.push_back(e.info());
+        return v;
+    }();
+    return infos;
+}
+
+}  // namespace
+
+ModelInfo EmptyModel::StaticInfo() {
+    ModelInfo info;
+    info.name = "empty";
+    info.title = "Empty (constant white)";
+    info.citation = "seed 003 section 11.2.1";
+    info.summary = "no physics: the overhead baseline of the render loop";
+    return info;
+}
+
+std::vector<ModelInfo> ListModels() { return Infos(); }
+
+const ModelInfo& GetModelInfo(const std::string& name) {
+    for (const ModelInfo& info : Infos()) {
+        if (info.name == name) return info;
+    }
+    std::string list;
+    for (const ModelInfo& info : Infos()) list += (list.empty() ? "" : ", ") + info.name;
+    Fail("unknown model '", name, "' (models: ", list, ")");
+}
+
+std::unique_ptr<Model> CreateModel(const std::string& name,
+                                   const std::map<std::string, std::string>& options) {
+    const ModelInfo& info = GetModelInfo(name);
+    const ModelOptions resolved(info.name, info.options, options);
+    for (size_t i = 0; i < Infos().size(); ++i) {
+        if (Infos()[i].name == name) return Registry()[i].create(resolved);
+    }
+    Fail("unknown model '", name, "'");
+}
+
+}  // namespace atmos

@@ -1,0 +1,36 @@
+// atmos: phase functions, normalised to integrate to 1 over the sphere (1/sr).
+//
+// nu is the cosine of the scattering angle: the angle between the direction the
+// light travels before and after scattering, i.e. nu = dot(view, sun) for a view
+// direction pointing away from the camera and a direction pointing to the sun
+// (seed 004 convention). Sources:
+//   Rayleigh:         3/(16 pi) (1 + nu^2)                     seed 004 RayleighPhaseFunction
+//   Cornette-Shanks:  3/(8 pi) (1-g^2)(1+nu^2) / ((2+g^2)(1+g^2-2 g nu)^1.5)
+//                                                               seed 003 Eq. 5, seed 004
+//   Henyey-Greenstein: 1/(4 pi) (1-g^2) / (1+g^2-2 g nu)^1.5    Henyey & Greenstein 1941
+//                     (seed 003 Eq. 6 writes +2g cos theta with theta measured
+//                      from the backward direction; here nu = +cos of the angle
+//                      between propagation directions, so forward peaks at nu = 1)
+//   isotropic:        1/(4 pi)                                  seed 003 Eq. 7
+#pragma once
+
+#include "atmos/math.h"
+
+namespace atmos {
+
+ATMOS_HD inline double RayleighPhase(double nu) { return 3.0 / (16.0 * kPi) * (1.0 + nu * nu); }
+
+ATMOS_HD inline double CornetteShanksPhase(double g, double nu) {
+    const double k = 3.0 / (8.0 * kPi) * (1.0 - g * g) / (2.0 + g * g);
+    const double denom = 1.0 + g * g - 2.0 * g * nu;
+    return k * (1.0 + nu * nu) / (denom * Sqrt(denom));
+}
+
+ATMOS_HD inline double HenyeyGreensteinPhase(double g, double nu) {
+    const double denom = 1.0 + g * g - 2.0 * g * nu;
+    return (1.0 - g * g) / (4.0 * kPi * denom * Sqrt(denom));
+}
+
+ATMOS_HD inline double IsotropicPhase() { return 1.0 / (4.0 * kPi); }
+
+}  // namespace atmos

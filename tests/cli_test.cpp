@@ -1,0 +1,164 @@
+// End-to-end tests of the `atmos` executable: outputs and every error path.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "atmos/image.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path TempDir() {
+    const char* env = std::getenv("ATMOS_TEST_TMP");
+    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
+    dir /= "cli";
+    fs::create_directories(dir);
+    return dir;
+}
+
+struct Result {
+    int status = -1;
+    std::string out;
+    std::string err;
+};
+
+std::string Slurp(const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+// Runs `atmos ARGS` (stdin from `input` if not empty), capturing both streams.
+Result RunAtmos(const std::string& args, const std::string& input = "") {
+    static int counter = 0;
+    const fs::path dir = TempDir();
+    const std::string id = std::to_string(++counter);
+    const fs::path out = dir / ("out" + id), err = dir / ("err" + id), in = dir / ("in" + id);
+    std::ofstream(in) << input;
+    const std::string cmd = std::string(ATMOS_CLI_PATH) + " " + args + " < " + in.string() + " > " +
+                            out.string() + " 2> " + err.string();
+    const int raw = std::system(cmd.c_str());
+    Result r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = Slurp(out);
+    r.err = Slurp(err);
+    return r;
+}
+
+// An error: non-zero exit and exactly one line on stderr, mentioning `needle`.
+void ExpectError(const std::string& args, const std::string& needle,
+                 const std::string& input = "") {
+    const Result r = RunAtmos(args, input);
+    EXPECT_NE(r.status, 0) << args;
+    EXPECT_NE(r.status, -1) << args << " crashed";
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("atmos: error: ", 0), 0u) << r.err;
+}
+
+TEST(Cli, List) {
+    const Result r = RunAtmos("list");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.out.find("naive"), std::string::npos);
+    EXPECT_NE(r.out.find("planet-shadow-orbit"), std::string::npos);
+    EXPECT_NE(r.out.find("earth-bruneton"), std::string::npos);
+}
+
+TEST(Cli, RenderWritesEveryFormat) {
+    for (const char* ext : {"exr", "png", "npy", "pfm"}) {
+        const fs::path out = TempDir() / (std::string("render.") + ext);
+        fs::remove(out);
+        const Result r = RunAtmos("render --model naive --view ground-sunrise --size 32x18 -q -o " +
+                                  out.string());
+        EXPECT_EQ(r.status, 0) << r.err;
+        ASSERT_TRUE(fs::exists(out)) << ext;
+        const atmos::Image image = atmos::ReadImage(out.string());
+        EXPECT_EQ(image.width(), 32);
+        EXPECT_EQ(image.height(), 18);
+    }
+}
+
+TEST(Cli, RenderAllViewsWritesAGallery) {
+    const fs::path dir = TempDir() / "gallery";
+    fs::remove_all(dir);
+    const Result r = RunAtmos("render --model naive --view all --size 16x9 -q -o " + dir.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir / "index.html"));
+    EXPECT_TRUE(fs::exists(dir / "naive-space.png"));
+    EXPECT_TRUE(fs::exists(dir / "naive-orbit-noon.exr"));
+    const std::string html = Slurp(dir / "index.html");
+    EXPECT_NE(html.find("naive-planet-shadow-ground.png"), std::string::npos);
+}
+
+TEST(Cli, SampleFollowsTheContract) {
+    const Result r = RunAtmos("sample --model naive",
+                              "altitude_m,mu,mu_s,azimuth_deg\n0,1,1,0\n1000,-0.5,0.5,30\n");
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::istringstream lines(r.out);
+    std::string header, first, second;
+    std::getline(lines, header);
+    std::getline(lines, first);
+    std::getline(lines, second);
+    EXPECT_EQ(header, "altitude_m,mu,mu_s,azimuth_deg,L_r,L_g,L_b,T_r,T_g,T_b");
+    EXPECT_EQ(std::count(first.begin(), first.end(), ','), 9);
+    EXPECT_NE(second.find(",0,0,0"), std::string::npos) << second;  // hits the ground: T = 0
+}
+
+TEST(Cli, ModelOptionsReachTheModel) {
+    const std::string in = "altitude_m,mu,mu_s,azimuth_deg\n0,0.05,0.1,0\n";
+    const Result a = RunAtmos("sample --model naive --steps 4", in);
+    const Result b = RunAtmos("sample --model naive --steps 64", in);
+    ASSERT_EQ(a.status, 0) << a.err;
+    ASSERT_EQ(b.status, 0) << b.err;
+    EXPECT_NE(a.out, b.out);
+}
+
+TEST(Cli, ErrorPaths) {
+    const std::string o = " -o " + (TempDir() / "x.png").string();
+    ExpectError("render --model nope --view ground-noon" + o, "unknown model 'nope'");
+    ExpectError("render --view nowhere" + o, "unknown view 'nowhere'");
+    ExpectError("render --view ground-noon --size 12" + o, "malformed size '12'");
+    ExpectError("render --view ground-noon --size 0x10" + o, "malformed size");
+    ExpectError("render --view ground-noon --size -3x10" + o, "size");
+    ExpectError("render --view ground-noon --size 100000x10" + o, "malformed size");
+    ExpectError("render --view ground-noon -o out.jpg", "out.jpg");
+    ExpectError("render --view ground-noon", "-o");
+    ExpectError("render --view ground-noon --quantity colour" + o, "unknown quantity");
+    ExpectError("render --atmosphere /no/such/file.json" + o, "/no/such/file.json");
+    ExpectError("render --set mie_phase_g=1.5" + o, "mie_phase_g");
+    ExpectError("render --set no_such_field=1" + o, "no_such_field");
+    ExpectError("render --set mie_phase_g" + o, "mie_phase_g");
+    ExpectError("render --model empty --steps 3" + o, "--steps");
+    ExpectError("render --model naive --steps 0" + o, "--steps");
+    ExpectError("render --model naive --steps many" + o, "--steps");
+    ExpectError("render --bogus-flag" + o, "bogus");
+    ExpectError("frobnicate", "frobnicate");
+    ExpectError("sample --model naive", "header", "");
+    ExpectError("sample --model naive", "header", "a,b,c\n");
+    ExpectError("sample --model naive", "not a finite number",
+                "altitude_m,mu,mu_s,azimuth_deg\n0,nan,1,0\n");
+    ExpectError("sample --model naive", "line 2", "altitude_m,mu,mu_s,azimuth_deg\n0,1,1\n");
+    ExpectError("sample --model naive", "mu must be", "altitude_m,mu,mu_s,azimuth_deg\n0,2,1,0\n");
+    ExpectError("sample --model naive", "altitude_m must",
+                "altitude_m,mu,mu_s,azimuth_deg\n-5,1,1,0\n");
+    const fs::path bad_json = TempDir() / "bad.json";
+    std::ofstream(bad_json) << "{ \"bottom_radius\": 6360e3, ";
+    ExpectError("render --atmosphere " + bad_json.string() + o, "bad.json");
+}
+
+TEST(Cli, Help) {
+    const Result r = RunAtmos("render --help");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.out.find("--steps"), std::string::npos);
+}
+
+}  // namespace
