@@ -34,7 +34,8 @@ fi
 werror=OFF
 if [ -n "${CI:-}" ]; then werror=ON; fi
 build_type=Release
-if [ "$sanitize" = ON ]; then build_type=RelWithDebInfo; fi
+cuda=AUTO
+if [ "$sanitize" = ON ]; then build_type=RelWithDebInfo; cuda=OFF; fi
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" \
-      -DATMOS_WERROR="$werror" -DATMOS_SANITIZE="$sanitize" >/dev/null
+      -DATMOS_WERROR="$werror" -DATMOS_SANITIZE="$sanitize" -DATMOS_CUDA="$cuda" >/dev/null
 cmake --build "$build_dir" -j "$(nproc)"

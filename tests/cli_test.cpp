@@ -1,6 +1,7 @@
 // End-to-end tests of the `atmos` executable: outputs and every error path.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -41,7 +42,8 @@ std::string Slurp(const fs::path& p) {
 Result RunAtmos(const std::string& args, const std::string& input = "") {
     static int counter = 0;
     const fs::path dir = TempDir();
-    const std::string id = std::to_string(++counter);
+    // Unique per process: ctest runs each test in its own process, in parallel.
+    const std::string id = std::to_string(getpid()) + "_" + std::to_string(++counter);
     const fs::path out = dir / ("out" + id), err = dir / ("err" + id), in = dir / ("in" + id);
     std::ofstream(in) << input;
     const std::string cmd = std::string(ATMOS_CLI_PATH) + " " + args + " < " + in.string() + " > " +

@@ -35,7 +35,10 @@ class Image {
     Image() = default;
     Image(int width, int height) { Resize(width, height); }
 
+    // Negative sizes are clamped to 0 (callers validate sizes; see ParseSize).
     void Resize(int width, int height) {
+        width = width > 0 ? width : 0;
+        height = height > 0 ? height : 0;
         width_ = width;
         height_ = height;
         pixels_.assign(static_cast<size_t>(width) * height * 3, 0.0f);
@@ -73,9 +76,11 @@ ImageFormat ImageFormatFromPath(const std::string& path);  // throws atmos::Erro
 // only (float formats store linear values untouched). Throws atmos::Error.
 void WriteImage(const Image& image, const std::string& path, float exposure = 1.0f);
 
-// Reads EXR, NPY (float32 or float64, H x W x 3 or H x W) and PFM (colour or
-// grey) into linear RGB. PNG reads decode the sRGB curve to [0, 1] (no inverse
-// tone map). Throws atmos::Error on anything malformed.
+// Reads EXR (half or float R, G, B; Y alone as grey), NPY (float32 or float64;
+// H x W x 3, H x W x 4 with alpha dropped, H x W x 1 or H x W as grey) and PFM
+// (colour or grey) into linear RGB. PNG reads always decode the sRGB curve to
+// [0, 1] (gAMA/iCCP chunks ignored, alpha dropped, no inverse tone map).
+// Throws atmos::Error on anything malformed.
 Image ReadImage(const std::string& path);
 
 }  // namespace atmos
