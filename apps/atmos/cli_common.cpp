@@ -1,0 +1,61 @@
+#include "cli_common.h"
+
+#include <set>
+
+#include "atmos/error.h"
+#include "atmos/model.h"
+
+namespace atmos::cli {
+
+void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
+    cmd->add_option("--model,-m", o->model, "model name (see `atmos list`)")->capture_default_str();
+    cmd->add_option("--atmosphere,-a", o->atmosphere, "preset name or JSON file")
+        ->capture_default_str();
+    cmd->add_option("--set", o->sets, "override one atmosphere field: FIELD=VALUE (repeatable)")
+        ->allow_extra_args(false);
+    cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_flag("--quiet,-q", o->quiet, "no progress bar or timing lines");
+    std::set<std::string> seen;
+    for (const ModelInfo& info : ListModels()) {
+        for (const ModelOptionSpec& spec : info.options) {
+            if (!seen.insert(spec.name).second) continue;
+            o->model_option_flags[spec.name] =
+                cmd->add_option(
+                       "--" + spec.name, o->model_option_values[spec.name],
+                       spec.help + " (model " + info.name + ", default " + spec.default_value + ")")
+                    ->group("Model options");
+        }
+    }
+}
+
+std::map<std::string, std::string> GivenModelOptions(const CommonOptions& o) {
+    std::map<std::string, std::string> given;
+    for (const auto& [name, flag] : o.model_option_flags) {
+        if (flag->count() > 0) given[name] = o.model_option_values.at(name);
+    }
+    return given;
+}
+
+// "WxH" with 1 <= W, H <= 16384.
+void ParseSize(const std::string& text, int* width, int* height) {
+    const size_t x = text.find('x');
+    auto parse = [&](const std::string& part, int* out) {
+        if (part.empty() || part.size() > 6 ||
+            part.find_first_not_of("0123456789") != std::string::npos) {
+            return false;
+        }
+        *out = std::stoi(part);
+        return *out >= 1 && *out <= 16384;
+    };
+    if (x == std::string::npos || !parse(text.substr(0, x), width) ||
+        !parse(text.substr(x + 1), height)) {
+        Fail("malformed size '", text, "': expected WIDTHxHEIGHT, each in [1, 16384]");
+    }
+}
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+}  // namespace atmos::cli

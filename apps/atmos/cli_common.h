@@ -1,0 +1,49 @@
+// atmos CLI: options and helpers shared by the subcommands.
+//
+// Each subcommand lives in its own file (cmd_*.cpp or main.cpp) and registers
+// itself through a function declared here, returning the CLI11 subcommand and
+// the function that runs it once parsed.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace atmos::cli {
+
+// Options every model-running command takes: --model, --atmosphere, --set,
+// --threads, --quiet, and every model's own options.
+struct CommonOptions {
+    std::string model = "naive";
+    std::string atmosphere = "earth";
+    std::vector<std::string> sets;
+    int threads = 0;
+    bool quiet = false;
+    // Model options: every option of every model is declared (so --help lists
+    // them); after parsing, those given must belong to the chosen model.
+    std::map<std::string, std::string> model_option_values;
+    std::map<std::string, CLI::Option*> model_option_flags;
+};
+
+void AddCommonOptions(CLI::App* cmd, CommonOptions* o);
+// The model options given on the command line (name -> text).
+std::map<std::string, std::string> GivenModelOptions(const CommonOptions& o);
+// "WxH" with 1 <= W, H <= 16384; throws atmos::Error otherwise.
+void ParseSize(const std::string& text, int* width, int* height);
+double Seconds(std::chrono::steady_clock::time_point since);
+
+// A registered subcommand: its CLI11 app and what runs it (returns the exit status).
+struct Command {
+    CLI::App* app = nullptr;
+    std::function<int()> run;
+};
+
+// Registration functions, one per subcommand file.
+Command AddListCommand(CLI::App* root);
+Command AddRenderCommand(CLI::App* root);
+Command AddSampleCommand(CLI::App* root);
+
+}  // namespace atmos::cli

@@ -1,0 +1,134 @@
+// atmos CLI: `atmos render`.
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "atmos/atmosphere.h"
+#include "atmos/error.h"
+#include "atmos/image.h"
+#include "atmos/model.h"
+#include "atmos/view.h"
+#include "base/parallel.h"
+#include "cli_common.h"
+#include "harness/gallery.h"
+
+namespace fs = std::filesystem;
+
+namespace atmos::cli {
+
+namespace {
+
+struct RenderOptions {
+    std::string view = "ground-noon";
+    std::string size = "480x270";
+    std::string quantity = "radiance";
+    std::string output;
+    bool sun_disc = false;
+    float exposure = 0.0f;  // 0: the view's
+};
+
+int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
+    int width = 0, height = 0;
+    ParseSize(ro.size, &width, &height);
+    const Quantity quantity = ParseQuantity(ro.quantity);
+    if (ro.output.empty()) Fail("render needs an output: -o FILE (or -o DIR with --view all)");
+    const bool all_views = ro.view == "all";
+    if (!all_views) ImageFormatFromPath(ro.output);  // fail before the work on a bad name
+    if (!std::isfinite(ro.exposure) || ro.exposure < 0.0f) {
+        Fail("--exposure must be a positive number");
+    }
+
+    ThreadLimit limit(common.threads);
+    const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
+    std::unique_ptr<Model> model = CreateModel(common.model, GivenModelOptions(common));
+    std::vector<View> views;
+    if (all_views) {
+        views = StandardViews(atmosphere);
+    } else {
+        views.push_back(GetView(ro.view, atmosphere));
+    }
+
+    const auto prepare_start = std::chrono::steady_clock::now();
+    model->Prepare(atmosphere);
+    const double prepare_seconds = Seconds(prepare_start);
+    if (!common.quiet && prepare_seconds > 0.01) {
+        std::fprintf(stderr, "prepared %s in %.3f s\n", common.model.c_str(), prepare_seconds);
+    }
+
+    std::vector<GalleryEntry> gallery;
+    if (all_views) fs::create_directories(ro.output);
+    for (const View& view : views) {
+        RenderRequest request;
+        request.view = view;
+        request.width = width;
+        request.height = height;
+        request.quantity = quantity;
+        request.sun_disc = ro.sun_disc;
+        request.show_progress = !common.quiet;
+        Image image;
+        const auto start = std::chrono::steady_clock::now();
+        model->Render(request, &image);
+        const double seconds = Seconds(start);
+        const float exposure = ro.exposure > 0.0f                ? ro.exposure
+                               : quantity == Quantity::kRadiance ? view.exposure
+                                                                 : 1.0f;
+        if (all_views) {
+            const std::string stem = common.model + "-" + view.name;
+            WriteImage(image, (fs::path(ro.output) / (stem + ".png")).string(), exposure);
+            WriteImage(image, (fs::path(ro.output) / (stem + ".exr")).string(), exposure);
+            gallery.push_back(
+                {view.name, view.description, stem + ".png", stem + ".exr", seconds, exposure});
+        } else {
+            WriteImage(image, ro.output, exposure);
+        }
+        if (!common.quiet) {
+            std::fprintf(stderr, "rendered %-22s %dx%d with %s in %.3f s (%d threads)\n",
+                         view.name.c_str(), width, height, common.model.c_str(), seconds,
+                         ParallelThreadCount());
+        }
+    }
+    if (all_views) {
+        const ModelInfo& info = model->Info();
+        const std::string page = (fs::path(ro.output) / "index.html").string();
+        WriteGalleryHtml(page, "atmos: " + info.title,
+                         "model " + info.name + " (" + info.citation + "), atmosphere " +
+                             common.atmosphere + ", " + ro.size + ", " + ro.quantity +
+                             "; PNG: exposure, 1 - exp(-x), sRGB",
+                         gallery);
+        if (!common.quiet) std::fprintf(stderr, "wrote %s\n", page.c_str());
+    }
+    return 0;
+}
+
+}  // namespace
+
+Command AddRenderCommand(CLI::App* root) {
+    auto common = std::make_shared<CommonOptions>();
+    auto ro = std::make_shared<RenderOptions>();
+    Command c;
+    CLI::App* render = root->add_subcommand("render", "render one view (or all) with one model");
+    AddCommonOptions(render, common.get());
+    render->add_option("--view,-v", ro->view, "view name, or 'all' (-o is then a directory)")
+        ->capture_default_str();
+    render->add_option("--size,-s", ro->size, "image size WIDTHxHEIGHT")->capture_default_str();
+    render->add_option("--quantity", ro->quantity, "radiance or transmittance")
+        ->capture_default_str();
+    render->add_flag("--sun-disc", ro->sun_disc, "add the sun's disc");
+    render->add_option("--exposure", ro->exposure, "PNG exposure (default: the view's)");
+    render->add_option("-o,--output", ro->output,
+                       "output file (.exr .png .npy .pfm), or directory with --view all");
+    c.app = render;
+    c.run = [common, ro] { return CmdRender(*common, *ro); };
+    return c;
+}
+
+}  // namespace atmos::cli

@@ -1,0 +1,145 @@
+// atmos: lookup tables (LUTs) and their sampling, on host and device.
+//
+// A table holds `channels` (1..4) floats per texel, x fastest, then y, then z.
+// Sampling follows GPU texture conventions: coordinates in [0, 1] address the
+// whole table, texel i has its centre at (i + 0.5) / size, filtering is linear
+// and borders clamp to the edge texel. Seed 004's mapping helpers
+// (GetTextureCoordFromUnitRange and its inverse) map [0, 1] onto the texel
+// centres so that the first and last texels hold the range's end points.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "atmos/math.h"
+
+namespace atmos {
+
+struct Vec4f {
+    float x = 0.0f, y = 0.0f, z = 0.0f, w = 0.0f;
+    ATMOS_HD Rgb rgb() const { return {x, y, z}; }
+};
+ATMOS_HD inline Vec4f operator+(const Vec4f& a, const Vec4f& b) {
+    return {a.x + b.x, a.y + b.y, a.z + b.z, a.w + b.w};
+}
+ATMOS_HD inline Vec4f operator*(const Vec4f& a, float s) {
+    return {a.x * s, a.y * s, a.z * s, a.w * s};
+}
+
+// Seed 004: x in [0, 1] -> texture coordinate of the texel centres.
+ATMOS_HD inline double GetTextureCoordFromUnitRange(double x, int texture_size) {
+    return 0.5 / texture_size + x * (1.0 - 1.0 / texture_size);
+}
+// Seed 004: the inverse.
+ATMOS_HD inline double GetUnitRangeFromTextureCoord(double u, int texture_size) {
+    return (u - 0.5 / texture_size) / (1.0 - 1.0 / texture_size);
+}
+
+// A non-owning, trivially copyable view of a table (device-copyable when
+// `data` points to device memory).
+struct TableView {
+    const float* data = nullptr;
+    int width = 0, height = 1, depth = 1;
+    int channels = 4;
+
+    ATMOS_HD Vec4f Fetch(int x, int y, int z = 0) const {
+        x = Clamp(x, 0, width - 1);
+        y = Clamp(y, 0, height - 1);
+        z = Clamp(z, 0, depth - 1);
+        const float* p = data + ((static_cast<size_t>(z) * height + y) * width + x) *
+                                    static_cast<size_t>(channels);
+        Vec4f v;
+        v.x = p[0];
+        if (channels > 1) v.y = p[1];
+        if (channels > 2) v.z = p[2];
+        if (channels > 3) v.w = p[3];
+        return v;
+    }
+
+    // Linear filtering along x and y (z: the layer, no filtering across layers).
+    ATMOS_HD Vec4f SampleBilinear(double u, double v, int layer = 0) const {
+        int x0, y0;
+        float fx, fy;
+        Split(u, width, &x0, &fx);
+        Split(v, height, &y0, &fy);
+        const Vec4f a = Fetch(x0, y0, layer) * (1.0f - fx) + Fetch(x0 + 1, y0, layer) * fx;
+        const Vec4f b = Fetch(x0, y0 + 1, layer) * (1.0f - fx) + Fetch(x0 + 1, y0 + 1, layer) * fx;
+        return a * (1.0f - fy) + b * fy;
+    }
+
+    ATMOS_HD Vec4f SampleTrilinear(double u, double v, double w) const {
+        int z0;
+        float fz;
+        Split(w, depth, &z0, &fz);
+        return SampleBilinear(u, v, z0) * (1.0f - fz) + SampleBilinear(u, v, z0 + 1) * fz;
+    }
+
+    // Texture coordinate -> lower texel index and fraction toward the next one,
+    // clamped to the edge texels.
+    ATMOS_HD static void Split(double u, int size, int* i0, float* f) {
+        double x = u * size - 0.5;
+        if (x < 0.0) x = 0.0;
+        if (x > size - 1) x = size - 1;
+        int i = static_cast<int>(x);
+        if (i > size - 2) i = size > 1 ? size - 2 : 0;
+        *i0 = i;
+        *f = size > 1 ? static_cast<float>(x - i) : 0.0f;
+    }
+};
+
+// A host-owned table.
+class Table {
+  public:
+    Table() = default;
+    Table(int width, int height, int depth, int channels) {
+        Resize(width, height, depth, channels);
+    }
+    void Resize(int width, int height, int depth, int channels) {
+        view_.width = width;
+        view_.height = height;
+        view_.depth = depth;
+        view_.channels = channels;
+        data_.assign(static_cast<size_t>(width) * height * depth * channels, 0.0f);
+        view_.data = data_.data();
+    }
+    Table(const Table& o) : data_(o.data_), view_(o.view_) { view_.data = data_.data(); }
+    Table& operator=(const Table& o) {
+        data_ = o.data_;
+        view_ = o.view_;
+        view_.data = data_.data();
+        return *this;
+    }
+    Table(Table&& o) noexcept : data_(std::move(o.data_)), view_(o.view_) {
+        view_.data = data_.data();
+    }
+    Table& operator=(Table&& o) noexcept {
+        data_ = std::move(o.data_);
+        view_ = o.view_;
+        view_.data = data_.data();
+        return *this;
+    }
+
+    const TableView& view() const { return view_; }
+    int width() const { return view_.width; }
+    int height() const { return view_.height; }
+    int depth() const { return view_.depth; }
+    int channels() const { return view_.channels; }
+    float* data() { return data_.data(); }
+    const float* data() const { return data_.data(); }
+    size_t size() const { return data_.size(); }
+    float* Texel(int x, int y, int z = 0) {
+        return data_.data() + ((static_cast<size_t>(z) * view_.height + y) * view_.width + x) *
+                                  static_cast<size_t>(view_.channels);
+    }
+    void Set(int x, int y, int z, const Vec4f& v) {
+        float* p = Texel(x, y, z);
+        const float values[4] = {v.x, v.y, v.z, v.w};
+        for (int c = 0; c < view_.channels; ++c) p[c] = values[c];
+    }
+
+  private:
+    std::vector<float> data_;
+    TableView view_;
+};
+
+}  // namespace atmos

@@ -1,0 +1,66 @@
+// Tests of LUT sampling and table files.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "atmos/error.h"
+#include "base/texture.h"
+#include "io/table_io.h"
+
+namespace atmos {
+namespace {
+
+TEST(Texture, UnitRangeMappingRoundTripsAndHitsTexelCentres) {
+    for (int n : {2, 8, 256}) {
+        EXPECT_DOUBLE_EQ(GetTextureCoordFromUnitRange(0.0, n), 0.5 / n);
+        EXPECT_DOUBLE_EQ(GetTextureCoordFromUnitRange(1.0, n), 1.0 - 0.5 / n);
+        for (double x : {0.0, 0.3, 1.0}) {
+            EXPECT_NEAR(GetUnitRangeFromTextureCoord(GetTextureCoordFromUnitRange(x, n), n), x,
+                        1e-15);
+        }
+    }
+}
+
+TEST(Texture, BilinearReproducesALinearFunctionAndClampsAtEdges) {
+    // f(x, y) = 2 x + 3 y stored at texel centres is reproduced exactly inside.
+    Table t(5, 4, 1, 1);
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 5; ++x) t.Texel(x, y)[0] = static_cast<float>(2 * x + 3 * y);
+    const TableView v = t.view();
+    EXPECT_NEAR(v.SampleBilinear((1.5 + 0.5) / 5.0, (2.25 + 0.5) / 4.0).x, 2 * 1.5 + 3 * 2.25,
+                1e-5);
+    EXPECT_FLOAT_EQ(v.SampleBilinear(0.0, 0.0).x, 0.0f);   // clamp to the first texel
+    EXPECT_FLOAT_EQ(v.SampleBilinear(1.0, 1.0).x, 17.0f);  // and to the last
+    EXPECT_FLOAT_EQ(v.SampleBilinear(-3.0, 9.0).x, 9.0f);  // far outside
+}
+
+TEST(Texture, TrilinearInterpolatesLayers) {
+    Table t(2, 2, 3, 2);
+    for (int z = 0; z < 3; ++z)
+        for (int y = 0; y < 2; ++y)
+            for (int x = 0; x < 2; ++x) t.Set(x, y, z, {static_cast<float>(z), 1.0f, 0, 0});
+    EXPECT_NEAR(t.view().SampleTrilinear(0.5, 0.5, (0.75 + 0.5) / 3.0).x, 0.75, 1e-6);
+    EXPECT_FLOAT_EQ(t.view().SampleTrilinear(0.5, 0.5, 0.5).y, 1.0f);
+}
+
+TEST(TableIo, ExrRoundTripIsExact) {
+    const char* env = std::getenv("ATMOS_TEST_TMP");
+    const std::filesystem::path dir =
+        env ? std::filesystem::path(env) : std::filesystem::temp_directory_path() / "atmos_test";
+    std::filesystem::create_directories(dir);
+    const std::string path = (dir / "table_roundtrip.exr").string();
+    Table t(7, 3, 4, 3);
+    for (size_t i = 0; i < t.size(); ++i) t.data()[i] = 1e-7f * static_cast<float>(i * i) + 0.25f;
+    WriteTableExr(t, path);
+    const Table back = ReadTableExr(path, 4, 3);
+    ASSERT_EQ(back.width(), 7);
+    ASSERT_EQ(back.depth(), 4);
+    for (size_t i = 0; i < t.size(); ++i) ASSERT_EQ(back.data()[i], t.data()[i]) << i;
+    EXPECT_THROW(ReadTableExr(path, 3, 3), Error);  // 28 columns are not 3 layers
+    EXPECT_THROW(ReadTableExr(path, 4, 4), Error);  // no A channel
+    EXPECT_THROW(ReadTableExr((dir / "missing.exr").string(), 1, 1), Error);
+}
+
+}  // namespace
+}  // namespace atmos
