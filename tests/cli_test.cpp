@@ -144,6 +144,9 @@ TEST(Cli, ErrorPaths) {
     ExpectError("render --model naive --steps many" + o, "--steps");
     ExpectError("render --bogus-flag" + o, "bogus");
     ExpectError("frobnicate", "frobnicate");
+    ExpectError("bake --model naive -o " + (TempDir() / "bake").string(), "no precomputed tables");
+    ExpectError("bake --model naive", "--output");
+    ExpectError("render --model naive --load /nonexistent" + o, "no precomputed tables to load");
     ExpectError("sample --model naive", "header", "");
     ExpectError("sample --model naive", "header", "a,b,c\n");
     ExpectError("sample --model naive", "not a finite number",

@@ -16,6 +16,9 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_flag("--quiet,-q", o->quiet, "no progress bar or timing lines");
+    cmd->add_option("--load", o->load,
+                    "read the model's tables from a directory written by `atmos bake` instead of "
+                    "precomputing them");
     std::set<std::string> seen;
     for (const ModelInfo& info : ListModels()) {
         for (const ModelOptionSpec& spec : info.options) {
@@ -56,6 +59,16 @@ void ParseSize(const std::string& text, int* width, int* height) {
 
 double Seconds(std::chrono::steady_clock::time_point since) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphere, Model* model) {
+    const auto start = std::chrono::steady_clock::now();
+    if (o.load.empty()) {
+        model->Prepare(atmosphere);
+    } else {
+        model->LoadBaked(o.load, atmosphere);
+    }
+    return Seconds(start);
 }
 
 }  // namespace atmos::cli

@@ -12,6 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "atmos/atmosphere.h"
+#include "atmos/model.h"
+
 namespace atmos::cli {
 
 // Options every model-running command takes: --model, --atmosphere, --set,
@@ -22,6 +25,7 @@ struct CommonOptions {
     std::vector<std::string> sets;
     int threads = 0;
     bool quiet = false;
+    std::string load;  // --load DIR: read baked tables instead of Prepare()
     // Model options: every option of every model is declared (so --help lists
     // them); after parsing, those given must belong to the chosen model.
     std::map<std::string, std::string> model_option_values;
@@ -34,6 +38,9 @@ std::map<std::string, std::string> GivenModelOptions(const CommonOptions& o);
 // "WxH" with 1 <= W, H <= 16384; throws atmos::Error otherwise.
 void ParseSize(const std::string& text, int* width, int* height);
 double Seconds(std::chrono::steady_clock::time_point since);
+// Prepare()s the model for the atmosphere, or loads its baked tables with
+// --load; returns the seconds it took.
+double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphere, Model* model);
 
 // A registered subcommand: its CLI11 app and what runs it (returns the exit status).
 struct Command {
@@ -45,5 +52,6 @@ struct Command {
 Command AddListCommand(CLI::App* root);
 Command AddRenderCommand(CLI::App* root);
 Command AddSampleCommand(CLI::App* root);
+Command AddBakeCommand(CLI::App* root);
 
 }  // namespace atmos::cli

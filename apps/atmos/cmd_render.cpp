@@ -57,9 +57,7 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         views.push_back(GetView(ro.view, atmosphere));
     }
 
-    const auto prepare_start = std::chrono::steady_clock::now();
-    model->Prepare(atmosphere);
-    const double prepare_seconds = Seconds(prepare_start);
+    const double prepare_seconds = PrepareModel(common, atmosphere, model.get());
     if (!common.quiet && prepare_seconds > 0.01) {
         std::fprintf(stderr, "prepared %s in %.3f s\n", common.model.c_str(), prepare_seconds);
     }

@@ -91,7 +91,7 @@ int CmdSample(const CommonOptions& common) {
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(common.model, GivenModelOptions(common));
     const std::vector<SampleQuery> queries = ReadQueries(std::cin);
-    model->Prepare(atmosphere);
+    PrepareModel(common, atmosphere, model.get());
     const std::vector<SampleAnswer> answers = model->Sample(queries);
     std::printf("altitude_m,mu,mu_s,azimuth_deg,L_r,L_g,L_b,T_r,T_g,T_b\n");
     for (size_t i = 0; i < queries.size(); ++i) {

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
         AddListCommand(&app),
         AddRenderCommand(&app),
         AddSampleCommand(&app),
+        AddBakeCommand(&app),
     };
     try {
         if (argc > 1 && argv[1][0] != '-') {

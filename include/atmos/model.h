@@ -112,6 +112,15 @@ class Model {
     // atmosphere's solar irradiance) or transmittance into `out` (resized).
     virtual void Render(const RenderRequest& request, Image* out) const = 0;
     virtual std::vector<SampleAnswer> Sample(const std::vector<SampleQuery>& queries) const = 0;
+
+    // Precomputed tables as files (`atmos bake`, `--load`): models with tables
+    // override all three. Bake writes the tables of the last Prepare() to
+    // `directory` (EXR + a JSON describing sizes, mappings and the atmosphere);
+    // LoadBaked replaces Prepare() by reading them back (throws atmos::Error if
+    // they do not match `atmosphere` or the model's options).
+    virtual bool CanBake() const { return false; }
+    virtual void Bake(const std::string& directory) const;
+    virtual void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere);
 };
 
 // All registered models, in the registry's order (src/atmos/models/registry.cpp).

@@ -87,6 +87,14 @@ ModelOptions::ModelOptions(const std::string& model_name, const std::vector<Mode
     }
 }
 
+void Model::Bake(const std::string&) const {
+    Fail("model ", Info().name, " has no precomputed tables to bake");
+}
+
+void Model::LoadBaked(const std::string&, const AtmosphereParameters&) {
+    Fail("model ", Info().name, " has no precomputed tables to load");
+}
+
 int ModelOptions::GetInt(const std::string& name) const {
     return static_cast<int>(std::lround(GetReal(name)));
 }
