@@ -33,7 +33,9 @@ struct RenderOptions {
     std::string quantity = "radiance";
     std::string output;
     bool sun_disc = false;
-    float exposure = 0.0f;  // 0: the view's
+    float exposure = 0.0f;   // 0: the view's
+    std::string checkpoint;  // Monte Carlo models: checkpoint stem (default: OUTPUT.ckpt)
+    bool resume = false;
 };
 
 int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
@@ -72,6 +74,19 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         request.quantity = quantity;
         request.sun_disc = ro.sun_disc;
         request.show_progress = !common.quiet;
+        const bool stochastic = model->Info().capabilities.stochastic;
+        Image variance;
+        std::string out_stem = fs::path(ro.output).replace_extension().string();
+        if (all_views) {
+            out_stem = (fs::path(ro.output) / (common.model + "-" + view.name)).string();
+        }
+        if (stochastic && quantity == Quantity::kRadiance) {
+            request.checkpoint = ro.checkpoint.empty() ? out_stem + ".ckpt"
+                                 : all_views           ? ro.checkpoint + "-" + view.name
+                                                       : ro.checkpoint;
+            request.resume = ro.resume;
+            request.variance = &variance;
+        }
         Image image;
         const auto start = std::chrono::steady_clock::now();
         model->Render(request, &image);
@@ -88,6 +103,7 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         } else {
             WriteImage(image, ro.output, exposure);
         }
+        if (!variance.empty()) WriteImage(variance, out_stem + ".variance.exr");
         if (!common.quiet) {
             std::fprintf(stderr, "rendered %-22s %dx%d with %s in %.3f s (%d threads)\n",
                          view.name.c_str(), width, height, common.model.c_str(), seconds,
@@ -124,6 +140,11 @@ Command AddRenderCommand(CLI::App* root) {
     render->add_option("--exposure", ro->exposure, "PNG exposure (default: the view's)");
     render->add_option("-o,--output", ro->output,
                        "output file (.exr .png .npy .pfm), or directory with --view all");
+    render->add_option("--checkpoint", ro->checkpoint,
+                       "Monte Carlo models: checkpoint file stem (default: OUTPUT without its "
+                       "extension + .ckpt); checkpoints hold the sums and the sample count");
+    render->add_flag("--resume", ro->resume,
+                     "Monte Carlo models: continue from the checkpoint of the same render");
     c.app = render;
     c.run = [common, ro] { return CmdRender(*common, *ro); };
     return c;

@@ -99,6 +99,12 @@ struct RenderRequest {
     Quantity quantity = Quantity::kRadiance;
     bool sun_disc = false;  // add the sun's disc (radiance E / (pi alpha^2) times T)
     bool show_progress = true;
+    // Monte Carlo models (ModelCapabilities::stochastic): checkpoint file stem
+    // (empty: no checkpoints), whether to resume from it, and an optional image
+    // that receives the per-pixel variance of the estimate (same units squared).
+    std::string checkpoint;
+    bool resume = false;
+    Image* variance = nullptr;
 };
 
 class Model {

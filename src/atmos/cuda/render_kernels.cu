@@ -6,6 +6,7 @@
 
 #include "models/empty.h"
 #include "models/naive.h"
+#include "models/reference.h"
 #include "render/render.h"
 
 namespace atmos {
@@ -33,6 +34,8 @@ cudaError_t LaunchRender(const Evaluator& evaluator, const PixelSetup& setup, fl
 
 template cudaError_t LaunchRender<EmptyEvaluator>(const EmptyEvaluator&, const PixelSetup&, float*,
                                                   cudaStream_t);
+template cudaError_t LaunchRender<ReferenceEvaluator>(const ReferenceEvaluator&, const PixelSetup&,
+                                                      float*, cudaStream_t);
 template cudaError_t LaunchRender<NaiveEvaluator>(const NaiveEvaluator&, const PixelSetup&, float*,
                                                   cudaStream_t);
 

@@ -8,6 +8,7 @@
 #include "atmos/model.h"
 #include "models/empty.h"
 #include "models/naive.h"
+#include "models/reference.h"
 
 namespace atmos {
 
@@ -28,6 +29,7 @@ const std::vector<Entry>& Registry() {
     static const std::vector<Entry> entries = {
         MakeEntry<EmptyModel>(),
         MakeEntry<NaiveModel>(),
+        MakeEntry<ReferenceModel>(),
     };
     return entries;
 }

@@ -13,9 +13,16 @@
 // the atmosphere, the light reflected by the ground where the ray ends
 // (attenuated to the camera; only when want_ground), and the transmittance of
 // the ray's segment through the atmosphere (to the ground, or to space).
+//
+// Monte Carlo evaluators declare `static constexpr bool kStochastic = true` and
+// implement instead
+//   RayResult EvaluateKeyed(camera, dir, sun, want_ground, uint64_t key) const;
+// where `key` identifies the pixel (or query) so that random numbers depend on
+// the pixel and sample index only (src/atmos/base/rng.h).
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "atmos/image.h"
@@ -50,11 +57,32 @@ struct PixelSetup {
 
 PixelSetup MakePixelSetup(const RenderRequest& request, const AtmosphereParameters& atmosphere);
 
+// True for evaluators that declare kStochastic (they take a pixel key).
+template <typename E, typename = void>
+struct IsStochastic : std::false_type {};
+template <typename E>
+struct IsStochastic<E, std::void_t<decltype(E::kStochastic)>>
+    : std::integral_constant<bool, E::kStochastic> {};
+
+template <typename Evaluator>
+ATMOS_HD inline RayResult EvaluateRay(const Evaluator& evaluator, const Vec3d& camera,
+                                      const Vec3d& dir, const Vec3d& sun, bool want_ground,
+                                      uint64_t key) {
+    if constexpr (IsStochastic<Evaluator>::value) {
+        return evaluator.EvaluateKeyed(camera, dir, sun, want_ground, key);
+    } else {
+        (void)key;
+        return evaluator.Evaluate(camera, dir, sun, want_ground);
+    }
+}
+
 template <typename Evaluator>
 ATMOS_HD inline Rgb ShadePixel(const Evaluator& evaluator, const PixelSetup& s, int x, int y) {
     const Vec3d dir = s.camera.RayDirection(x, y, s.width, s.height);
+    const uint64_t key =
+        static_cast<uint64_t>(y) * static_cast<uint64_t>(s.width) + static_cast<uint64_t>(x);
     const RayResult r =
-        evaluator.Evaluate(s.camera.position, dir, s.sun_direction, !s.transmittance);
+        EvaluateRay(evaluator, s.camera.position, dir, s.sun_direction, !s.transmittance, key);
     if (s.transmittance) return SanitizeRadiance(r.transmittance);
     Rgb radiance = (r.sky + r.ground) * s.irradiance;
     if (s.sun_disc && !r.hits_ground && Dot(dir, s.sun_direction) >= s.cos_sun_radius) {
@@ -66,30 +94,37 @@ ATMOS_HD inline Rgb ShadePixel(const Evaluator& evaluator, const PixelSetup& s, 
 // Renders every pixel of `out` (already sized s.width x s.height) on the CPU:
 // 16 x 16 tiles in parallel; each pixel depends on its coordinates only, so the
 // image is the same for any thread count.
+// `progress` (may be null) is advanced by one per pixel.
 template <typename Evaluator>
 void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView out,
-                 bool show_progress) {
+                 Progress* progress) {
     constexpr int kTile = 16;
-    Progress progress("render", static_cast<int64_t>(setup.width) * setup.height, show_progress);
     ParallelForTiles(setup.width, setup.height, kTile, [&](int x0, int y0, int x1, int y1) {
         for (int y = y0; y < y1; ++y) {
             for (int x = x0; x < x1; ++x) out.Set(x, y, ShadePixel(evaluator, setup, x, y));
         }
-        progress.Add(static_cast<int64_t>(x1 - x0) * (y1 - y0));
+        if (progress) progress->Add(static_cast<int64_t>(x1 - x0) * (y1 - y0));
     });
+}
+
+template <typename Evaluator>
+void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView out,
+                 bool show_progress) {
+    Progress progress("render", static_cast<int64_t>(setup.width) * setup.height, show_progress);
+    RenderImage(evaluator, setup, out, &progress);
 }
 
 // The sample contract of DESIGN.md for one query, through an evaluator.
 template <typename Evaluator>
 ATMOS_HD inline SampleAnswer SampleOne(const Evaluator& evaluator, double bottom_radius,
-                                       const SampleQuery& q) {
+                                       const SampleQuery& q, uint64_t key = 0) {
     const double sin_v = SafeSqrt(1.0 - q.mu * q.mu);
     const double sin_s = SafeSqrt(1.0 - q.mu_s * q.mu_s);
     const double az = Radians(q.azimuth_deg);
     const Vec3d camera(0.0, 0.0, bottom_radius + q.altitude_m);
     const Vec3d dir(sin_v, 0.0, q.mu);
     const Vec3d sun(sin_s * cos(az), sin_s * sin(az), q.mu_s);
-    const RayResult r = evaluator.Evaluate(camera, dir, sun, false);
+    const RayResult r = EvaluateRay(evaluator, camera, dir, sun, false, key);
     SampleAnswer a;
     a.radiance = SanitizeRadiance(r.sky);
     a.transmittance = r.hits_ground ? Rgb(0.0f) : SanitizeRadiance(r.transmittance);
@@ -101,8 +136,8 @@ std::vector<SampleAnswer> SampleAll(const Evaluator& evaluator, double bottom_ra
                                     const std::vector<SampleQuery>& queries) {
     std::vector<SampleAnswer> answers(queries.size());
     ParallelFor(static_cast<int64_t>(queries.size()), 64, [&](int64_t i) {
-        answers[static_cast<size_t>(i)] =
-            SampleOne(evaluator, bottom_radius, queries[static_cast<size_t>(i)]);
+        answers[static_cast<size_t>(i)] = SampleOne(
+            evaluator, bottom_radius, queries[static_cast<size_t>(i)], static_cast<uint64_t>(i));
     });
     return answers;
 }

@@ -1,0 +1,358 @@
+// atmos model `reference`: the Monte Carlo path tracer every model is measured against.
+//
+// Source: seed 003 sections 3.2, 4 and 11.2.2 (delta and ratio tracking after
+// Fong et al. 2017 and Pharr et al. 2016, as Hillaire 2020's reference), with
+// two changes that keep it unbiased and make it converge faster:
+//
+// * Spectral tracking (Kutz et al. 2017, "Spectral and Decomposition Tracking
+//   for Rendering Heterogeneous Volumes", SIGGRAPH): one path carries all three
+//   channels. Free-flight distances are sampled against a majorant sigma_bar >=
+//   the extinction of every channel; at each tentative collision the event
+//   (Rayleigh scattering, Mie scattering or null collision) is chosen with
+//   probabilities proportional to the path-throughput-weighted channel averages
+//   of sigma_R, sigma_M and sigma_n = sigma_bar - sigma_t, and the throughput of
+//   channel c is multiplied by (sigma_e,c / sigma_bar) / P_e. Absorption (Mie
+//   absorption, ozone) is never sampled as an event: its contribution is zero
+//   (no emission), so leaving it out is unbiased and it acts through the
+//   weights. Each channel's estimator is unbiased; the thesis traced one random
+//   channel per path (also unbiased, three times the paths).
+// * A piecewise-constant majorant over 48 spherical shells (altitudes
+//   h_k = Delta (k/48)^2, fine near the ground), each the exact maximum of the
+//   extinction over its shell (per-layer critical points of seed 004's
+//   profiles). Tracking steps to the shell boundary and resamples there
+//   (memoryless). A global majorant is the special case of one shell
+//   (`--shells 1`); bench/reference_bench.cpp measures both.
+//
+// Light: next-event estimation toward the sun at every scattering vertex, the
+// sun's transmittance by ratio tracking (Novak et al. 2014; seed 003 Eq. 13)
+// against the same majorants, per channel (unbiased, and cheaper here than a
+// deterministic integral of comparable accuracy); a light ray that hits the
+// ground is blocked (planet shadow). The sun is directional (the other models
+// treat it so too). A Lambertian ground of the atmosphere's albedo: NEE to the
+// sun and a cosine-sampled bounce; albedo 0 ends the path (a black ground that
+// still blocks light). Phase sampling: Rayleigh exactly (Cardano), Cornette-
+// Shanks through Henyey-Greenstein with the weight CS/HG <= 1.5.
+//
+// Orders: `--max-order K` counts scattering vertices (volume or ground); 0 =
+// unlimited with Russian roulette from the 4th vertex. Random numbers come from
+// (seed, pixel, sample index) only (base/rng.h). The transmittance output is
+// deterministic: the view segment's optical depth by the trapezoidal rule with
+// 1024 intervals (noise-free; seed 004's transmittance uses 500).
+//
+// Output: radiance per unit solar irradiance. `sky` gathers paths whose first
+// vertex is in the atmosphere, `ground` paths whose first vertex is the ground
+// (DESIGN.md: `sample` reports only the former).
+// Valid: everywhere (any camera, any sun). Deviations from the thesis: all
+// channels per path, shell majorants, unlimited orders by default (the thesis
+// used 4: `--max-order 4`), ratio tracking instead of delta tracking to the sun.
+#pragma once
+
+#include <stdint.h>
+
+#include "atmos/atmosphere.h"
+#include "atmos/model.h"
+#include "base/rng.h"
+#include "physics/density.h"
+#include "physics/geometry.h"
+#include "physics/phase.h"
+#include "physics/sampling.h"
+#include "physics/transmittance.h"
+#include "render/render.h"
+
+namespace atmos {
+
+constexpr int kMaxReferenceShells = 64;
+
+// Shells of the piecewise-constant majorant: shell i spans radii
+// [radius[i], radius[i + 1]); radius[0] = bottom, radius[count] = top.
+struct MajorantShells {
+    int count = 1;
+    double radius[kMaxReferenceShells + 1] = {};
+    double majorant[kMaxReferenceShells] = {};  // 1/m, >= every channel's extinction
+
+    ATMOS_HD int ShellOf(double r) const {
+        int i = 0;
+        while (i + 1 < count && r >= radius[i + 1]) ++i;
+        return i;
+    }
+};
+
+// Builds `count` shells for the atmosphere (count 1: one global majorant).
+MajorantShells BuildMajorantShells(const AtmosphereParameters& atm, int count);
+// The exact maximum of a profile's (clamped) density over altitudes [h0, h1].
+double MaxProfileDensity(const DensityProfile& profile, double h0, double h1);
+
+struct ReferenceEvaluator {
+    static constexpr bool kStochastic = true;
+
+    AtmosphereParameters atm;
+    MajorantShells shells;
+    uint64_t seed = 0;
+    int sample_begin = 0;  // the samples [sample_begin, sample_begin + sample_count)
+    int sample_count = 1;
+    int max_order = 0;  // 0: unlimited (Russian roulette)
+
+    enum class Step { kCollision, kGround, kEscaped };
+
+    // Moves p along dir to the next tentative collision of the piecewise-
+    // constant majorant (shell updated), or to the ground or out of the top.
+    // Distance from p (in `shell`) along dir to the shell's boundary, and the
+    // shell entered there (-1: the ground, shells.count: space).
+    ATMOS_HD double ShellExit(const Vec3d& p, const Vec3d& dir, int shell, int* next) const {
+        const double r = Length(p);
+        const double mu = ClampCosine(Dot(p, dir) / r);
+        const double inner = shells.radius[shell];
+        if (RayIntersectsGround(r, mu, inner)) {
+            *next = shell - 1;
+            return DistanceToBottomAtmosphereBoundary(r, mu, inner);
+        }
+        *next = shell + 1;
+        return DistanceToTopAtmosphereBoundary(r, mu, shells.radius[shell + 1]);
+    }
+
+    // Majorant optical depth from p along dir up to distance `length` (or the
+    // ground / space, whichever comes first).
+    ATMOS_HD double MajorantDepth(Vec3d p, const Vec3d& dir, int shell, double length) const {
+        double tau = 0.0;
+        for (int guard = 0; guard < 4 * kMaxReferenceShells + 4 && length > 0.0; ++guard) {
+            int next;
+            const double t = Min(ShellExit(p, dir, shell, &next), length);
+            tau += shells.majorant[shell] * t;
+            length -= t;
+            p = p + dir * t;
+            shell = next;
+            if (next < 0 || next >= shells.count) break;
+        }
+        return tau;
+    }
+
+    // Moves p along dir to where the majorant optical depth reaches tau.
+    ATMOS_HD void AdvanceMajorantDepth(Vec3d* p, const Vec3d& dir, int* shell, double tau) const {
+        for (int guard = 0; guard < 4 * kMaxReferenceShells + 4; ++guard) {
+            int next;
+            const double t_exit = ShellExit(*p, dir, *shell, &next);
+            const double sigma_bar = shells.majorant[*shell];
+            if (sigma_bar > 0.0 && tau < sigma_bar * t_exit) {
+                *p = *p + dir * (tau / sigma_bar);
+                return;
+            }
+            tau -= sigma_bar * t_exit;
+            *p = *p + dir * t_exit;
+            if (next < 0 || next >= shells.count) return;  // rounding at the very end
+            *shell = next;
+        }
+    }
+
+    // `scale` (>= 1) multiplies the majorants (a looser majorant: see RatioTracking).
+    ATMOS_HD Step Track(Vec3d* p, const Vec3d& dir, int* shell, Rng& rng,
+                        double scale = 1.0) const {
+        for (int guard = 0; guard < 100000; ++guard) {
+            int next;
+            const double t_exit = ShellExit(*p, dir, *shell, &next);
+            const double sigma_bar = scale * shells.majorant[*shell];
+            const double t = sigma_bar > 0.0 ? -log(1.0 - rng.Uniform()) / sigma_bar : t_exit + 1.0;
+            if (t < t_exit) {
+                *p = *p + dir * t;
+                return Step::kCollision;
+            }
+            *p = *p + dir * t_exit;
+            *shell = next;
+            if (next < 0) {
+                *p = Normalize(*p) * atm.bottom_radius;
+                *shell = 0;
+                return Step::kGround;
+            }
+            if (next >= shells.count) return Step::kEscaped;
+        }
+        return Step::kEscaped;
+    }
+
+    // Transmittance from p toward `dir` to space by ratio tracking (0 if the
+    // ray meets the ground), per channel; unbiased.
+    //
+    // With a majorant k times the extinction, the estimate's relative variance
+    // in a homogeneous medium is exp(tau / k) - 1 (Novak et al. 2014): a tight
+    // majorant (k ~ 1) is hopeless in deep shadow (tau = 14: 1e6). So the
+    // majorants are scaled by k = max(1, tau_bar), tau_bar the ray's majorant
+    // optical depth (computed exactly by walking the shells): the relative
+    // variance stays below e - 1 at a cost of ~tau_bar^2 steps, and sun rays with
+    // tau_bar <= 1 (most of them) are unchanged.
+    ATMOS_HD Vec3d RatioTracking(Vec3d p, const Vec3d& dir, int shell, Rng& rng) const {
+        const double r = Length(p);
+        if (RayIntersectsGround(r, ClampCosine(Dot(p, dir) / r), atm.bottom_radius)) {
+            return Vec3d(0.0);
+        }
+        const double k = Max(1.0, MajorantDepth(p, dir, shell, 1e300));
+        Vec3d t(1.0);
+        for (int guard = 0; guard < 1000000; ++guard) {
+            const Step step = Track(&p, dir, &shell, rng, k);
+            if (step == Step::kEscaped) return t;
+            if (step == Step::kGround) return Vec3d(0.0);
+            const Densities d = GetDensities(atm, Length(p) - atm.bottom_radius);
+            const Vec3d sigma_t = Extinction(atm, d);
+            t = t * (Vec3d(1.0) - sigma_t / (k * shells.majorant[shell]));
+            if (MaxComponent(t) <= 0.0) return t;
+        }
+        return t;
+    }
+
+    // One path from `origin` (inside the atmosphere or on its boundary) along
+    // `dir`; adds its radiance to *sky (first vertex in the atmosphere) or
+    // *ground (first vertex on the ground).
+    //
+    // `forced_depth` > 0 forces the first tentative collision inside the view
+    // segment (forced collision: the free-flight distance is sampled
+    // conditioned on colliding before the segment ends, whose majorant optical
+    // depth is forced_depth, and the path is weighted by the probability of
+    // that, 1 - exp(-forced_depth)). Unbiased when the segment's end
+    // contributes nothing (space, or a black ground); it removes the paths
+    // that cross thin segments without a collision and carry nothing.
+    //
+    // The forced collision's distance is drawn from an equal mixture of that
+    // density (concentrated where the air is dense) and a uniform density over
+    // the segment (which reaches the thin, still sunlit air at twilight and at
+    // the limb), weighted by one-sample MIS with the balance heuristic: the
+    // weight T_bar(t) sigma_bar(t) / q(t), q the mixture's pdf, then the usual
+    // event choice.
+    ATMOS_HD void TracePath(Vec3d p, Vec3d dir, int shell, const Vec3d& sun, Rng& rng,
+                            double forced_depth, double forced_length, Vec3d* sky,
+                            Vec3d* ground) const {
+        Vec3d w(1.0);
+        Vec3d radiance;
+        int order = 0;
+        bool first_on_ground = false;
+        const double bar = 1.0 / 3.0;
+        for (int guard = 0; guard < 1000000; ++guard) {
+            Step step;
+            if (forced_depth > 0.0) {
+                const double p_collide = -expm1(-forced_depth);
+                const Vec3d start = p;
+                const int start_shell = shell;
+                double tau;
+                if (rng.Uniform() < 0.5) {
+                    tau = -log1p(-rng.Uniform() * p_collide);
+                    AdvanceMajorantDepth(&p, dir, &shell, tau);
+                } else {
+                    const double t = rng.Uniform() * forced_length;
+                    tau = MajorantDepth(start, dir, start_shell, t);
+                    p = start + dir * t;
+                    shell = shells.ShellOf(Length(p));
+                }
+                const double density = shells.majorant[shell] * exp(-tau);  // sigma_bar T_bar
+                const double q = 0.5 * density / p_collide + 0.5 / forced_length;
+                w = w * (density / q);
+                forced_depth = 0.0;
+                step = Step::kCollision;
+            } else {
+                step = Track(&p, dir, &shell, rng);
+            }
+            if (step == Step::kEscaped) break;
+            if (step == Step::kGround) {
+                if (order == 0) first_on_ground = true;
+                ++order;
+                if (max_order > 0 && order > max_order) break;
+                if (MaxComponent(atm.ground_albedo) <= 0.0) break;
+                const Vec3d n = Normalize(p);
+                const double cos_sun = Dot(n, sun);
+                if (cos_sun > 0.0) {
+                    radiance +=
+                        w * atm.ground_albedo * (cos_sun / kPi) * RatioTracking(p, sun, 0, rng);
+                }
+                dir = MakeDirection(n, SampleCosineHemisphereCosine(rng.Uniform()), rng.Uniform());
+                w = w * atm.ground_albedo;
+            } else {
+                const Densities d = GetDensities(atm, Length(p) - atm.bottom_radius);
+                const Vec3d sigma_r = atm.rayleigh_scattering * d.rayleigh;
+                const Vec3d sigma_m = atm.mie_scattering * d.mie;
+                const double sigma_bar = shells.majorant[shell];
+                const Vec3d sigma_n = Vec3d(sigma_bar) - Extinction(atm, d);
+                const double a_r = Dot(w, sigma_r) * bar;
+                const double a_m = Dot(w, sigma_m) * bar;
+                const double a_n = Max(Dot(w, sigma_n), 0.0) * bar;
+                const double total = a_r + a_m + a_n;
+                if (!(total > 0.0)) break;
+                const double xi = rng.Uniform() * total;
+                if (xi >= a_r + a_m) {  // null collision: continue straight on
+                    w = w * sigma_n * (1.0 / (sigma_bar * (a_n / total)));
+                    continue;
+                }
+                const bool rayleigh = xi < a_r;
+                w = w * (rayleigh ? sigma_r : sigma_m) *
+                    (1.0 / (sigma_bar * ((rayleigh ? a_r : a_m) / total)));
+                ++order;
+                if (max_order > 0 && order > max_order) break;
+                const double nu = Dot(dir, sun);
+                const double phase =
+                    rayleigh ? RayleighPhase(nu) : CornetteShanksPhase(atm.mie_phase_g, nu);
+                radiance += w * phase * RatioTracking(p, sun, shell, rng);
+                if (rayleigh) {
+                    dir = MakeDirection(dir, SampleRayleighCosine(rng.Uniform()), rng.Uniform());
+                } else {
+                    const double mu = SampleHenyeyGreensteinCosine(atm.mie_phase_g, rng.Uniform());
+                    w = w * CornetteShanksOverHenyeyGreenstein(atm.mie_phase_g, mu);
+                    dir = MakeDirection(dir, mu, rng.Uniform());
+                }
+            }
+            // Russian roulette from the 4th vertex on (unlimited orders).
+            if (order >= 3) {
+                const double q = Min(0.95, MaxComponent(w));
+                if (rng.Uniform() >= q) break;
+                w = w * (1.0 / q);
+            }
+        }
+        if (first_on_ground) {
+            *ground += radiance;
+        } else {
+            *sky += radiance;
+        }
+    }
+
+    ATMOS_HD RayResult EvaluateKeyed(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                                     bool want_ground, uint64_t key) const {
+        RayResult out;
+        out.transmittance = Rgb(1.0f);
+        const AtmosphereSegment seg =
+            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
+        out.hits_ground = seg.hits_ground;
+        if (!seg.inside) return out;
+        const Vec3d start = camera + dir * seg.t_start;
+        out.transmittance = Rgb(Exp(-OpticalDepth(atm, start, dir, seg.t_end - seg.t_start, 1024)));
+        const int shell = seg.t_start > 0.0 ? shells.count - 1 : shells.ShellOf(Length(start));
+        // Forced first collision unless the segment ends on a reflecting ground.
+        const bool reflective_end = seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0;
+        const double forced =
+            reflective_end ? 0.0 : MajorantDepth(start, dir, shell, seg.t_end - seg.t_start);
+        Vec3d sky, ground;
+        for (int s = 0; s < sample_count; ++s) {
+            Rng rng(seed, key, static_cast<uint64_t>(sample_begin + s));
+            TracePath(start, dir, shell, sun, rng, forced, seg.t_end - seg.t_start, &sky, &ground);
+        }
+        if (sample_count > 0) {
+            const double inv = 1.0 / sample_count;
+            out.sky = Rgb(sky * inv);
+            if (want_ground) out.ground = Rgb(ground * inv);
+        }
+        return out;
+    }
+};
+
+class ReferenceModel : public Model {
+  public:
+    explicit ReferenceModel(const ModelOptions& options);
+    static ModelInfo StaticInfo();
+    const ModelInfo& Info() const override { return info_; }
+    void Prepare(const AtmosphereParameters& atmosphere) override;
+    void Render(const RenderRequest& request, Image* out) const override;
+    std::vector<SampleAnswer> Sample(const std::vector<SampleQuery>& queries) const override;
+    const ReferenceEvaluator& evaluator() const { return evaluator_; }
+    int spp() const { return spp_; }
+
+  private:
+    ModelInfo info_;
+    ReferenceEvaluator evaluator_;
+    int spp_ = 64;
+    int pass_spp_ = 0;  // 0: auto
+    int shell_count_ = 48;
+};
+
+}  // namespace atmos

@@ -1,0 +1,58 @@
+// atmos: importance sampling of phase functions and surfaces (host and device).
+//
+// Each sampler returns the cosine of the angle between the sampled direction
+// and the axis it is sampled around; MakeDirection builds the direction.
+#pragma once
+
+#include "atmos/math.h"
+
+namespace atmos {
+
+// Rayleigh phase 3/(16 pi)(1 + mu^2), sampled exactly: the CDF
+// F(mu) = (mu^3 + 3 mu + 4) / 8 = xi is the depressed cubic mu^3 + 3 mu + (4 - 8 xi) = 0,
+// solved by Cardano's formula: with u = 4 xi - 2, A = cbrt(u + sqrt(u^2 + 1)),
+// mu = A - 1 / A (the two cube roots multiply to -1).
+ATMOS_HD inline double SampleRayleighCosine(double xi) {
+    const double u = 4.0 * xi - 2.0;
+    const double a = cbrt(u + Sqrt(u * u + 1.0));
+    return Clamp(a - 1.0 / a, -1.0, 1.0);
+}
+
+// Henyey-Greenstein (forward peak at mu = 1 for g > 0), inverse CDF (e.g.
+// Pharr et al., PBRT 3rd ed., 15.2.3, with our sign convention).
+ATMOS_HD inline double SampleHenyeyGreensteinCosine(double g, double xi) {
+    if (Abs(g) < 1e-4) return 1.0 - 2.0 * xi;
+    const double s = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi);
+    return Clamp((1.0 + g * g - s * s) / (2.0 * g), -1.0, 1.0);
+}
+
+// Cornette-Shanks / Henyey-Greenstein with the same g: the weight of a
+// Cornette-Shanks sample drawn from Henyey-Greenstein, 3 (1 + mu^2) / (2 (2 + g^2)),
+// bounded by 3 / (2 + g^2) <= 1.5.
+ATMOS_HD inline double CornetteShanksOverHenyeyGreenstein(double g, double mu) {
+    return 1.5 * (1.0 + mu * mu) / (2.0 + g * g);
+}
+
+// An orthonormal basis around unit n (Duff et al. 2017, "Building an
+// orthonormal basis, revisited").
+ATMOS_HD inline void OrthonormalBasis(const Vec3d& n, Vec3d* t, Vec3d* b) {
+    const double sign = n.z >= 0.0 ? 1.0 : -1.0;
+    const double a = -1.0 / (sign + n.z);
+    const double c = n.x * n.y * a;
+    *t = Vec3d(1.0 + sign * n.x * n.x * a, sign * c, -sign * n.x);
+    *b = Vec3d(c, sign + n.y * n.y * a, -n.y);
+}
+
+// The unit direction at angle acos(mu) from axis n, azimuth 2 pi xi.
+ATMOS_HD inline Vec3d MakeDirection(const Vec3d& n, double mu, double xi) {
+    Vec3d t, b;
+    OrthonormalBasis(n, &t, &b);
+    const double s = SafeSqrt(1.0 - mu * mu);
+    const double phi = 2.0 * kPi * xi;
+    return Normalize(t * (s * cos(phi)) + b * (s * sin(phi)) + n * mu);
+}
+
+// Cosine-weighted hemisphere around n: mu = sqrt(xi) (pdf mu / pi).
+ATMOS_HD inline double SampleCosineHemisphereCosine(double xi) { return Sqrt(xi); }
+
+}  // namespace atmos
