@@ -242,6 +242,32 @@ TEST(ReferenceOrders, ZenithAtNoonGrowsWithOrder) {
         unlimited.Mean()[2] / o4.Mean()[2] - 1.0);
 }
 
+TEST(ReferenceEstimators, ThesisBaselineAgreesWithSpectral) {
+    // Both estimators are unbiased: their means at the zenith and near the
+    // sun at sunrise agree within 4 combined standard errors.
+    const AtmosphereParameters atm = EarthAtmosphere();
+    const Vec3d camera(0.0, 0.0, atm.bottom_radius);
+    const double el = Radians(6.0);
+    const Vec3d sun(std::cos(el), 0.0, std::sin(el));
+    for (const Vec3d& dir : {Vec3d(0, 0, 1), Normalize(Vec3d(1.0, 0.2, 0.15))}) {
+        Stats spectral, thesis;
+        ReferenceEvaluator e = MakeReference(atm);
+        for (int i = 0; i < 10000; ++i) {
+            e.sample_begin = i;
+            e.spectral = true;
+            spectral.Add(Vec3d(e.EvaluateKeyed(camera, dir, sun, false, 21).sky));
+            e.spectral = false;
+            thesis.Add(Vec3d(e.EvaluateKeyed(camera, dir, sun, false, 22).sky));
+        }
+        for (int c = 0; c < 3; ++c) {
+            const double se = std::hypot(spectral.StdError()[c], thesis.StdError()[c]);
+            EXPECT_NEAR(spectral.Mean()[c], thesis.Mean()[c], 4.0 * se) << c;
+            // The point of the spectral estimator: a smaller error per path.
+            EXPECT_LT(spectral.StdError()[c], thesis.StdError()[c]) << c;
+        }
+    }
+}
+
 TEST(ReferenceSymmetry, MirroredViewGivesMirroredImage) {
     // Camera yawed +30 deg and -30 deg from the sun's vertical plane: pixel x of
     // one equals pixel w-1-x of the other, within 4 standard errors of the

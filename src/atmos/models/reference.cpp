@@ -82,6 +82,15 @@ ModelInfo ReferenceModel::StaticInfo() {
     info.capabilities.stochastic = true;
     using T = ModelOptionSpec::Type;
     info.options = {
+        {"estimator",
+         T::kChoice,
+         "spectral",
+         "spectral: all channels per path (spectral tracking, forced first collision, "
+         "ratio-tracked sun); thesis: the thesis's estimator (one random channel per path, "
+         "delta tracking, uniform directions), kept as a baseline",
+         0,
+         0,
+         {"spectral", "thesis"}},
         {"spp", T::kInteger, "64", "paths per pixel (per query for sample)", 1, 1e9, {}},
         {"seed", T::kInteger, "0", "random seed", 0, 4294967295.0, {}},
         {"max-order",
@@ -116,6 +125,7 @@ ReferenceModel::ReferenceModel(const ModelOptions& options) : info_(StaticInfo()
     shell_count_ = options.GetInt("shells");
     evaluator_.seed = static_cast<uint64_t>(options.GetReal("seed"));
     evaluator_.max_order = options.GetInt("max-order");
+    evaluator_.spectral = options.GetText("estimator") == "spectral";
     Prepare(EarthAtmosphere());
 }
 

@@ -91,6 +91,11 @@ struct ReferenceEvaluator {
     int sample_begin = 0;  // the samples [sample_begin, sample_begin + sample_count)
     int sample_count = 1;
     int max_order = 0;  // 0: unlimited (Russian roulette)
+    // false: the thesis's estimator (seed 003 section 4: one random channel per
+    // path, plain delta tracking against the shells' majorant, delta tracking
+    // toward the sun, directions sampled uniformly). Kept as the baseline the
+    // spectral estimator is measured against (bench, docs/models.md).
+    bool spectral = true;
 
     enum class Step { kCollision, kGround, kEscaped };
 
@@ -307,6 +312,79 @@ struct ReferenceEvaluator {
         }
     }
 
+    // Thesis baseline: is the sun visible from p (delta tracking in channel c)?
+    ATMOS_HD bool SunVisibleDelta(Vec3d p, const Vec3d& dir, int shell, int c, Rng& rng) const {
+        const double r = Length(p);
+        if (RayIntersectsGround(r, ClampCosine(Dot(p, dir) / r), atm.bottom_radius)) return false;
+        for (int guard = 0; guard < 1000000; ++guard) {
+            const Step step = Track(&p, dir, &shell, rng);
+            if (step == Step::kEscaped) return true;
+            if (step == Step::kGround) return false;
+            const Vec3d sigma_t = Extinction(atm, GetDensities(atm, Length(p) - atm.bottom_radius));
+            if (rng.Uniform() * shells.majorant[shell] < sigma_t[c]) return false;
+        }
+        return false;
+    }
+
+    // Thesis baseline path (see `spectral`): adds to one random channel, times 3.
+    ATMOS_HD void TracePathThesis(Vec3d p, Vec3d dir, int shell, const Vec3d& sun, Rng& rng,
+                                  Vec3d* sky, Vec3d* ground) const {
+        const int c = Min(static_cast<int>(rng.Uniform() * 3.0), 2);
+        double w = 3.0;
+        double radiance = 0.0;
+        int order = 0;
+        bool first_on_ground = false;
+        for (int guard = 0; guard < 1000000; ++guard) {
+            const Step step = Track(&p, dir, &shell, rng);
+            if (step == Step::kEscaped) break;
+            if (step == Step::kGround) {
+                if (order == 0) first_on_ground = true;
+                ++order;
+                if ((max_order > 0 && order > max_order) || atm.ground_albedo[c] <= 0.0) break;
+                const Vec3d n = Normalize(p);
+                const double cos_sun = Dot(n, sun);
+                if (cos_sun > 0.0 && SunVisibleDelta(p, sun, 0, c, rng)) {
+                    radiance += w * atm.ground_albedo[c] * cos_sun / kPi;
+                }
+                dir = MakeDirection(n, SampleCosineHemisphereCosine(rng.Uniform()), rng.Uniform());
+                w *= atm.ground_albedo[c];
+            } else {
+                const Densities d = GetDensities(atm, Length(p) - atm.bottom_radius);
+                const double sigma_r = atm.rayleigh_scattering[c] * d.rayleigh;
+                const double sigma_m = atm.mie_scattering[c] * d.mie;
+                const double sigma_t = Extinction(atm, d)[c];
+                const double xi = rng.Uniform() * shells.majorant[shell];
+                if (xi >= sigma_t) continue;         // null collision
+                if (xi >= sigma_r + sigma_m) break;  // absorbed
+                const bool rayleigh = xi < sigma_r;
+                ++order;
+                if (max_order > 0 && order > max_order) break;
+                const double nu = Dot(dir, sun);
+                if (SunVisibleDelta(p, sun, shell, c, rng)) {
+                    radiance += w * (rayleigh ? RayleighPhase(nu)
+                                              : CornetteShanksPhase(atm.mie_phase_g, nu));
+                }
+                const Vec3d next = MakeDirection(dir, 1.0 - 2.0 * rng.Uniform(), rng.Uniform());
+                const double mu = Dot(next, dir);
+                w *= 4.0 * kPi *
+                     (rayleigh ? RayleighPhase(mu) : CornetteShanksPhase(atm.mie_phase_g, mu));
+                dir = next;
+            }
+            if (order >= 3) {
+                const double q = Min(0.95, w);
+                if (rng.Uniform() >= q) break;
+                w /= q;
+            }
+        }
+        Vec3d add;
+        add[c] = radiance;
+        if (first_on_ground) {
+            *ground += add;
+        } else {
+            *sky += add;
+        }
+    }
+
     ATMOS_HD RayResult EvaluateKeyed(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                      bool want_ground, uint64_t key) const {
         RayResult out;
@@ -325,7 +403,12 @@ struct ReferenceEvaluator {
         Vec3d sky, ground;
         for (int s = 0; s < sample_count; ++s) {
             Rng rng(seed, key, static_cast<uint64_t>(sample_begin + s));
-            TracePath(start, dir, shell, sun, rng, forced, seg.t_end - seg.t_start, &sky, &ground);
+            if (spectral) {
+                TracePath(start, dir, shell, sun, rng, forced, seg.t_end - seg.t_start, &sky,
+                          &ground);
+            } else {
+                TracePathThesis(start, dir, shell, sun, rng, &sky, &ground);
+            }
         }
         if (sample_count > 0) {
             const double inv = 1.0 / sample_count;
