@@ -82,6 +82,14 @@ ModelInfo ReferenceModel::StaticInfo() {
     info.capabilities.stochastic = true;
     using T = ModelOptionSpec::Type;
     info.options = {
+        {"sun-disc-light",
+         T::kInteger,
+         "0",
+         "1: light from the sun's disc (angular radius from the atmosphere), sampled per "
+         "next-event estimate; 0: a directional sun like the other models",
+         0,
+         1,
+         {}},
         {"estimator",
          T::kChoice,
          "spectral",
@@ -126,11 +134,13 @@ ReferenceModel::ReferenceModel(const ModelOptions& options) : info_(StaticInfo()
     evaluator_.seed = static_cast<uint64_t>(options.GetReal("seed"));
     evaluator_.max_order = options.GetInt("max-order");
     evaluator_.spectral = options.GetText("estimator") == "spectral";
+    sun_disc_light_ = options.GetInt("sun-disc-light") != 0;
     Prepare(EarthAtmosphere());
 }
 
 void ReferenceModel::Prepare(const AtmosphereParameters& atmosphere) {
     evaluator_.atm = atmosphere;
+    evaluator_.sun_cone_cos = sun_disc_light_ ? std::cos(atmosphere.sun_angular_radius) : 1.0;
     evaluator_.shells = BuildMajorantShells(atmosphere, shell_count_);
 }
 
@@ -156,6 +166,8 @@ nlohmann::json CheckpointKey(const RenderRequest& request, const ReferenceEvalua
     key["sun_disc"] = request.sun_disc;
     key["seed"] = e.seed;
     key["max_order"] = e.max_order;
+    key["estimator"] = e.spectral ? "spectral" : "thesis";
+    key["sun_cone_cos"] = e.sun_cone_cos;
     key["shells"] = e.shells.count;
     key["pass_spp"] = pass_spp;
     key["atmosphere"] = nlohmann::json::parse(AtmosphereToJson(e.atm));

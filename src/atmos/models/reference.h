@@ -96,6 +96,17 @@ struct ReferenceEvaluator {
     // toward the sun, directions sampled uniformly). Kept as the baseline the
     // spectral estimator is measured against (bench, docs/models.md).
     bool spectral = true;
+    // 1: the sun is a point (directional light, as the other models); < 1: the
+    // sun is a uniform disc of angular radius acos(sun_cone_cos), sampled
+    // uniformly in its cone for each next-event estimate (the irradiance stays
+    // 1, so the estimate is phase x transmittance for the sampled direction).
+    double sun_cone_cos = 1.0;
+
+    ATMOS_HD Vec3d SunDirection(const Vec3d& sun, Rng& rng) const {
+        if (sun_cone_cos >= 1.0) return sun;
+        const double mu = 1.0 - rng.Uniform() * (1.0 - sun_cone_cos);
+        return MakeDirection(sun, mu, rng.Uniform());
+    }
 
     enum class Step { kCollision, kGround, kEscaped };
 
@@ -258,10 +269,11 @@ struct ReferenceEvaluator {
                 if (max_order > 0 && order > max_order) break;
                 if (MaxComponent(atm.ground_albedo) <= 0.0) break;
                 const Vec3d n = Normalize(p);
-                const double cos_sun = Dot(n, sun);
+                const Vec3d light = SunDirection(sun, rng);
+                const double cos_sun = Dot(n, light);
                 if (cos_sun > 0.0) {
                     radiance +=
-                        w * atm.ground_albedo * (cos_sun / kPi) * RatioTracking(p, sun, 0, rng);
+                        w * atm.ground_albedo * (cos_sun / kPi) * RatioTracking(p, light, 0, rng);
                 }
                 dir = MakeDirection(n, SampleCosineHemisphereCosine(rng.Uniform()), rng.Uniform());
                 w = w * atm.ground_albedo;
@@ -286,10 +298,11 @@ struct ReferenceEvaluator {
                     (1.0 / (sigma_bar * ((rayleigh ? a_r : a_m) / total)));
                 ++order;
                 if (max_order > 0 && order > max_order) break;
-                const double nu = Dot(dir, sun);
+                const Vec3d light = SunDirection(sun, rng);
+                const double nu = Dot(dir, light);
                 const double phase =
                     rayleigh ? RayleighPhase(nu) : CornetteShanksPhase(atm.mie_phase_g, nu);
-                radiance += w * phase * RatioTracking(p, sun, shell, rng);
+                radiance += w * phase * RatioTracking(p, light, shell, rng);
                 if (rayleigh) {
                     dir = MakeDirection(dir, SampleRayleighCosine(rng.Uniform()), rng.Uniform());
                 } else {
@@ -436,6 +449,7 @@ class ReferenceModel : public Model {
     int spp_ = 64;
     int pass_spp_ = 0;  // 0: auto
     int shell_count_ = 48;
+    bool sun_disc_light_ = false;
 };
 
 }  // namespace atmos
