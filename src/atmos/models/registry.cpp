@@ -7,7 +7,18 @@
 #include "atmos/error.h"
 #include "atmos/model.h"
 #include "models/empty.h"
+#include "models/flat.h"
 #include "models/naive.h"
+#include "models/oneil.h"
+#include "models/preetham.h"
+#include "models/raymarched.h"
+#include "models/schuler.h"
+#include "models/transmittance_chapman.h"
+#include "models/transmittance_erfc.h"
+#include "models/transmittance_flat.h"
+#include "models/transmittance_oneil.h"
+#include "models/transmittance_polynomial.h"
+#include "models/transmittance_reference.h"
 
 namespace atmos {
 
@@ -28,6 +39,17 @@ const std::vector<Entry>& Registry() {
     static const std::vector<Entry> entries = {
         MakeEntry<EmptyModel>(),
         MakeEntry<NaiveModel>(),
+        MakeEntry<OneilModel>(),
+        MakeEntry<SchulerModel>(),
+        MakeEntry<FlatModel>(),
+        MakeEntry<RaymarchedModel>(),
+        MakeEntry<PreethamModel>(),
+        MakeEntry<TransmittanceReferenceModel>(),
+        MakeEntry<TransmittanceFlatModel>(),
+        MakeEntry<TransmittanceErfcModel>(),
+        MakeEntry<TransmittanceChapmanModel>(),
+        MakeEntry<TransmittanceOneilModel>(),
+        MakeEntry<TransmittancePolynomialModel>(),
     };
     return entries;
 }
