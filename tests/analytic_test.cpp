@@ -34,7 +34,7 @@ Vec3d Dir(double mu) { return Vec3d(std::sqrt(1.0 - mu * mu), 0.0, mu); }
 
 // Numerical optical length of exp(-h/H) "to infinity" (80 scale heights).
 double ToInfinity(double r, double mu, double H) {
-    return NumericalExpLength(r, mu, H, kR, kR + 80.0 * H, 20000);
+    return NumericalExpLength(r, mu, H, kR, kR + 80.0 * H, 8000);
 }
 
 TEST(AnalyticFlat, HomogeneousSlabMatchesEq47) {
@@ -93,38 +93,49 @@ TEST(AnalyticFlat, OzoneShellOfEarthIsEq59AndItsChordIsExact) {
 }
 
 // The Chapman approximation (seed 003 Eq. 24-25) against the numerical
-// integral. Bounds found (and written in docs/models.md): above the horizon
-// (mu in [0, 1], viewer at 0-20 km) the relative error reaches 24.1% for both
-// Earth scale heights (largest near mu = 0.05; 3.4% at the zenith for H = 8 km;
-// 20.2% at the horizon, where Ch(x, 90 deg) = sqrt(x) against the exact
-// sqrt(pi x / 2)); the complement form (rays below the horizon from 5-50 km
-// that miss the ground) stays within 20.3%.
+// integral. Bounds found (and written in docs/models.md), viewer at 0-20 km:
+//   seed unit (Eq. 25 as printed, c = sqrt(r / H)): above the horizon up to
+//   24.1% (near mu = 0.01-0.03; 3.4% at the zenith for H = 8 km; 20.2% at the
+//   horizon, where Ch(x, 90 deg) = sqrt(x) against sqrt(pi x / 2)); the
+//   complement form (rays below the horizon from 5-50 km that miss the
+//   ground) within 20.3%;
+//   half-height unit (Schuler's code, c = sqrt(r / (H ln 2))): up to 17.1%
+//   above the horizon (near mu = 0.02-0.05), 4.3% below.
 TEST(Chapman, ErrorBoundsAboveAndBelowTheHorizon) {
-    for (double H : {8000.0, 1200.0}) {
-        double up = 0.0, down = 0.0;
-        for (double h : {0.0, 1000.0, 5000.0, 20000.0}) {
-            for (int j = 0; j <= 40; ++j) {
-                const double mu = j / 40.0;
-                const double ref = ToInfinity(kR + h, mu, H);
-                up = std::max(up, std::fabs(ChapmanLengthToInfinity(kR + h, mu, H, kR) / ref - 1));
+    const struct {
+        double unit, bound_up, bound_down;
+    } units[] = {{kChapmanSeedUnit, 0.245, 0.21}, {kChapmanHalfHeightUnit, 0.175, 0.045}};
+    for (const auto& u : units) {
+        for (double H : {8000.0, 1200.0}) {
+            double up = 0.0, down = 0.0;
+            for (double h : {0.0, 1000.0, 5000.0, 20000.0}) {
+                for (int j = 0; j <= 40; ++j) {
+                    const double mu = j / 40.0;
+                    const double ref = ToInfinity(kR + h, mu, H);
+                    const double approx = ChapmanLengthToInfinity(kR + h, mu, H, kR, u.unit);
+                    up = std::max(up, std::fabs(approx / ref - 1));
+                }
             }
-        }
-        for (double h : {5000.0, 20000.0, 50000.0}) {
-            const double r = kR + h;
-            const double mu_h = -std::sqrt(1.0 - (kR / r) * (kR / r));
-            for (int j = 0; j < 40; ++j) {
-                const double mu = mu_h * j / 40.0;
-                const double ref = NumericalExpLength(r, mu, H, kR, kR + 80.0 * H, 40000);
-                down = std::max(down, std::fabs(ChapmanLengthToInfinity(r, mu, H, kR) / ref - 1));
+            for (double h : {5000.0, 20000.0, 50000.0}) {
+                const double r = kR + h;
+                const double mu_h = -std::sqrt(1.0 - (kR / r) * (kR / r));
+                for (int j = 0; j < 40; ++j) {
+                    const double mu = mu_h * j / 40.0;
+                    const double ref = NumericalExpLength(r, mu, H, kR, kR + 80.0 * H, 16000);
+                    const double approx = ChapmanLengthToInfinity(r, mu, H, kR, u.unit);
+                    down = std::max(down, std::fabs(approx / ref - 1));
+                }
             }
+            std::printf(
+                "[chapman] unit %.4f H, H %.0f m: max relative error above horizon %.4f, "
+                "below %.4f\n",
+                u.unit, H, up, down);
+            EXPECT_LT(up, u.bound_up);
+            EXPECT_LT(down, u.bound_down);
+            // Zenith: c / (1 + c), c = sqrt(r / (unit H)).
+            const double c = std::sqrt(kR / (u.unit * H));
+            EXPECT_NEAR(ChapmanLengthToInfinity(kR, 1.0, H, kR, u.unit) / H, c / (1.0 + c), 1e-12);
         }
-        std::printf("[chapman] H %.0f m: max relative error above horizon %.4f, below %.4f\n", H,
-                    up, down);
-        EXPECT_LT(up, 0.245);
-        EXPECT_LT(down, 0.21);
-        // Zenith: c / (1 + c), c = sqrt(r / H).
-        const double c = std::sqrt(kR / H);
-        EXPECT_NEAR(ChapmanLengthToInfinity(kR, 1.0, H, kR) / H, c / (1.0 + c), 1e-12);
     }
 }
 
@@ -295,6 +306,9 @@ TEST(Analytic, EveryModelIsFiniteAndNonNegativeOverASweep) {
         CheckModel<TransmittanceFlatModel>("transmittance-flat", atm);
         CheckModel<TransmittanceErfcModel>("transmittance-erfc", atm);
         CheckModel<TransmittanceChapmanModel>("transmittance-chapman", atm);
+        CheckModel<TransmittanceChapmanModel>("transmittance-chapman", atm,
+                                              {{"chapman-unit", "half-height"}});
+        CheckModel<SchulerModel>("schuler", atm, {{"steps", "8"}, {"chapman-unit", "half-height"}});
         CheckModel<TransmittanceOneilModel>("transmittance-oneil", atm);
         CheckModel<TransmittancePolynomialModel>("transmittance-polynomial", atm);
     }

@@ -1,5 +1,7 @@
 #include "models/schuler.h"
 
+#include "models/transmittance_chapman.h"
+
 namespace atmos {
 
 ModelInfo SchulerModel::StaticInfo() {
@@ -18,12 +20,14 @@ ModelInfo SchulerModel::StaticInfo() {
          1,
          1e5,
          {}},
+        ChapmanUnitOption(),
     };
     return info;
 }
 
 SchulerModel::SchulerModel(const ModelOptions& options) : info_(StaticInfo()) {
     evaluator_.steps = options.GetInt("steps");
+    evaluator_.chapman_unit = ChapmanUnitFromOptions(options);
     Prepare(EarthAtmosphere());
 }
 

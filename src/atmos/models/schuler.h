@@ -18,6 +18,8 @@
 //
 // Output: radiance per unit solar irradiance (1/sr); transmittance of the view
 // segment (Rayleigh + Mie). Ground: a/pi max(0, n.s) T_sun T_view.
+// `--chapman-unit seed|half-height`: Eq. 25 as the seed prints it (default) or
+// in Schuler's own unit, the 50% height H ln 2 (physics/analytic_optical_depth.h).
 // Valid: any camera and sun; error of the approximation: tests/analytic_test.cpp
 // (Chapman.*) and docs/models.md.
 #pragma once
@@ -37,6 +39,7 @@ struct SchulerEvaluator {
     AtmosphereParameters atm;  // profiles for the view ray
     AnalyticMedia m;           // scale heights and coefficients for the light
     int steps = 16;
+    double chapman_unit = kChapmanSeedUnit;  // `--chapman-unit`
 
     // Rayleigh + Mie extinction (no ozone) at an altitude.
     ATMOS_HD Vec3d ExtinctionAt(double altitude, double* rho_r, double* rho_m) const {
@@ -50,8 +53,9 @@ struct SchulerEvaluator {
         const double r = Length(p);
         const double mu_s = ClampCosine(Dot(p, sun) / r);
         if (RayIntersectsGround(r, mu_s, m.bottom)) return false;
-        *tau = m.rayleigh_scattering * ChapmanLengthToInfinity(r, mu_s, m.rayleigh_H, m.bottom) +
-               m.mie_extinction * ChapmanLengthToInfinity(r, mu_s, m.mie_H, m.bottom);
+        *tau = m.rayleigh_scattering *
+                   ChapmanLengthToInfinity(r, mu_s, m.rayleigh_H, m.bottom, chapman_unit) +
+               m.mie_extinction * ChapmanLengthToInfinity(r, mu_s, m.mie_H, m.bottom, chapman_unit);
         return true;
     }
 

@@ -62,21 +62,26 @@ ATMOS_HD inline double FlatLengthToInfinity(double r, double mu, double scale_he
 // Chapman function approximation of Schuler 2012 (seed 003 Eq. 24-25).
 
 // Optical length (m) from (r, mu) to infinity for density exp(-(r' - bottom)/H):
-//   mu >= 0: H exp(-h/H) c / (1 + c mu),                       c = sqrt(r/H)
+//   mu >= 0: H exp(-h/H) c / (1 + c mu),                       c = sqrt(r / (u H))
 //   mu <  0: 2 H sqrt(x0) exp((bottom - r_c)/H) - H exp(-h/H) c / (1 - c mu),
-//            x0 = sqrt(1 - mu^2) r / H = r_c / H
+//            x0 = sqrt(1 - mu^2) r / (u H) = r_c / (u H)
 // (Eq. 24-25 with x = (R+h)/H; the complement is Eq. 23: the full line through
-// the tangent point minus the part behind the viewer.) Ch(x, 90 deg) is taken
-// as sqrt(x) as the seed prints it (the exact asymptote is sqrt(pi x / 2)):
-// see tests/analytic_test.cpp for the error this gives.
+// the tangent point minus the part behind the viewer.) The seed prints Eq. 25
+// with the scale height as the unit (u = 1): then Ch(x, 90 deg) = sqrt(x)
+// against the exact asymptote sqrt(pi x / 2), 20% low. Schuler's own code
+// measures X and h in units of the 50%-height H ln 2 (exp2 instead of exp):
+// u = ln 2 gives Ch(x, 90 deg) = sqrt(x / ln 2), 4.2% low. Errors of both:
+// tests/analytic_test.cpp (Chapman.*) and docs/models.md.
+constexpr double kChapmanSeedUnit = 1.0;
+constexpr double kChapmanHalfHeightUnit = 0.69314718055994531;  // ln 2
 ATMOS_HD inline double ChapmanLengthToInfinity(double r, double mu, double scale_height,
-                                               double bottom) {
+                                               double bottom, double unit = kChapmanSeedUnit) {
     const double H = scale_height;
-    const double c = Sqrt(r / H);
+    const double c = Sqrt(r / (unit * H));
     const double density = SafeExp(-(r - bottom) / H);
     if (mu >= 0.0) return ClampLength(H * density * c / (1.0 + c * mu));
-    const double x0 = SafeSqrt(1.0 - mu * mu) * r / H;
-    const double tangent = 2.0 * H * Sqrt(x0) * SafeExp(bottom / H - x0);
+    const double r_c = SafeSqrt(1.0 - mu * mu) * r;
+    const double tangent = 2.0 * H * Sqrt(r_c / (unit * H)) * SafeExp((bottom - r_c) / H);
     return ClampLength(tangent - H * density * c / (1.0 - c * mu));
 }
 
