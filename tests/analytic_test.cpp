@@ -170,7 +170,8 @@ TEST(Erfc, SegmentMatchesNumericalIntegral) {
 // O'Neil's scale(): the original constants on the atmosphere they were fitted
 // for (thickness 2.5% of the radius, scale depth 0.25) and the refit. The seed
 // gives no accuracy figure for scale(); measured here (mu in [0, 1]): 2.45%
-// at the ground, within 6% over the fit altitudes.
+// at the ground, 4.9% over altitudes 0 to H; the refit (least squares, then
+// Lawson's minimax reweighting): 2.9%.
 TEST(Oneil, OriginalScaleReproducesItsAtmosphereAndRefitDoesAtLeastAsWell) {
     const double top = kR * 1.025, H = 0.25 * (top - kR);
     const OneilScale original = OriginalOneilScale(H, kR, top);
@@ -197,7 +198,7 @@ TEST(Oneil, RefitBeatsTheOriginalOnEarthAndMars) {
         const AtmosphereParameters* atm;
         double H;
         double bound;  // measured refit error over mu in [0, 1], rounded up
-    } cases[] = {{&earth, 8000.0, 0.16}, {&earth, 1200.0, 0.41}, {&mars, 11100.0, 0.075}};
+    } cases[] = {{&earth, 8000.0, 0.08}, {&earth, 1200.0, 0.26}, {&mars, 11100.0, 0.035}};
     for (const auto& c : cases) {
         const double bottom = c.atm->bottom_radius, top = c.atm->top_radius;
         const OneilScale refit = FitOneilScale(c.H, bottom, top);
@@ -327,11 +328,11 @@ TEST(Analytic, TransmittanceModelsAgreeWithTheReferenceLookingUp) {
     } cases[] = {{"transmittance-flat", true, 0.01},
                  {"transmittance-erfc", false, 0.002},
                  {"transmittance-chapman", false, 0.06},
-                 {"transmittance-oneil", false, 0.02},
+                 {"transmittance-oneil", false, 0.03},
                  {"transmittance-polynomial", true, 0.1},
                  {"flat", true, 0.01},
                  {"raymarched", true, 0.01},
-                 {"oneil", false, 0.02},
+                 {"oneil", false, 0.03},
                  {"schuler", false, 0.02}};
     for (const Case& c : cases) {
         const AtmosphereParameters atm = c.ozone ? EarthAtmosphere() : no_ozone;

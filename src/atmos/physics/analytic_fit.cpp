@@ -55,26 +55,57 @@ OneilScale OriginalOneilScale(double H, double bottom, double top) {
 OneilScale FitOneilScale(double H, double bottom, double top) {
     OneilScale s = OriginalOneilScale(H, bottom, top);
     const double thickness = top - bottom;
-    // Normal equations of the degree-4 polynomial in x = 1 - mu.
-    double ata[25] = {0.0};
-    double atb[5] = {0.0};
-    const double heights[5] = {0.0, 0.25 * H, 0.5 * H, H, 2.0 * H};
+    // Data: y = log(l / (H exp(-h/H))) at x = 1 - mu.
+    std::vector<double> xs, ys;
+    const double heights[4] = {0.0, 0.25 * H, 0.5 * H, H};
     for (double h : heights) {
         if (h > 0.5 * thickness) continue;
         for (int j = 0; j < 64; ++j) {
             const double mu = j / 63.0;
             const double l = NumericalExpLength(bottom + h, mu, H, bottom, top, 1000);
-            const double y = std::log(l / (H * std::exp(-h / H)));
-            const double x = 1.0 - mu;
-            double powers[5] = {1.0, x, x * x, x * x * x, x * x * x * x};
-            for (int p = 0; p < 5; ++p) {
-                atb[p] += powers[p] * y;
-                for (int q = 0; q < 5; ++q) ata[p * 5 + q] += powers[p] * powers[q];
-            }
+            xs.push_back(1.0 - mu);
+            ys.push_back(std::log(l / (H * std::exp(-h / H))));
         }
     }
-    if (!SolveLinearSystem(5, ata, atb)) Fail("oneil: the scale() refit is singular");
-    for (int p = 0; p < 5; ++p) s.c[p] = atb[p];
+    // Weighted least squares of the degree-4 polynomial (normal equations);
+    // Lawson's iteration (weights times the absolute residual) then moves the
+    // least-squares solution toward the smallest maximum error in log space,
+    // i.e. the smallest maximum relative error of the optical length. The best
+    // maximum error seen is kept, so the result is never worse than plain
+    // least squares.
+    std::vector<double> w(xs.size(), 1.0 / static_cast<double>(xs.size()));
+    double best_max = 1e300;
+    for (int iter = 0; iter < 60; ++iter) {
+        double ata[25] = {0.0};
+        double atb[5] = {0.0};
+        for (size_t i = 0; i < xs.size(); ++i) {
+            const double x = xs[i];
+            const double powers[5] = {1.0, x, x * x, x * x * x, x * x * x * x};
+            for (int p = 0; p < 5; ++p) {
+                atb[p] += w[i] * powers[p] * ys[i];
+                for (int q = 0; q < 5; ++q) ata[p * 5 + q] += w[i] * powers[p] * powers[q];
+            }
+        }
+        if (!SolveLinearSystem(5, ata, atb)) {
+            if (iter == 0) Fail("oneil: the scale() refit is singular");
+            break;
+        }
+        OneilScale trial = s;
+        for (int p = 0; p < 5; ++p) trial.c[p] = atb[p];
+        double max_error = 0.0, weight_sum = 0.0;
+        for (size_t i = 0; i < xs.size(); ++i) {
+            const double e = std::fabs(trial.Polynomial(xs[i]) - ys[i]);
+            max_error = std::max(max_error, e);
+            w[i] *= e;
+            weight_sum += w[i];
+        }
+        if (max_error < best_max) {
+            best_max = max_error;
+            s = trial;
+        }
+        if (weight_sum <= 0.0) break;
+        for (double& wi : w) wi /= weight_sum;
+    }
     return s;
 }
 

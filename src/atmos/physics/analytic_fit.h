@@ -17,11 +17,13 @@ double NumericalExpLength(double r, double mu, double H, double bottom, double t
 // partial pivoting; b is replaced by x. Returns false for a singular system.
 bool SolveLinearSystem(int n, double* a, double* b);
 
-// Least-squares refit of O'Neil's scale() polynomial (OneilScale::c) for one
-// exponential medium of scale height H in the atmosphere [bottom, top]: fits
+// Refit of O'Neil's scale() polynomial (OneilScale::c) for one exponential
+// medium of scale height H in the atmosphere [bottom, top]: fits
 // log(l(h, mu) / (H exp(-h/H))) = p(1 - mu) over mu in [0, 1] (64 values) and
-// altitudes h in {0, H/4, H/2, H, 2H} (clipped to the atmosphere), l the
-// numerical optical length to the top (NumericalExpLength).
+// altitudes h in {0, H/4, H/2, H, 2H} (those below half the thickness), l the
+// numerical optical length to the top (NumericalExpLength): least squares,
+// then Lawson's iteratively reweighted least squares toward the minimax fit
+// (the best maximum error is kept).
 OneilScale FitOneilScale(double H, double bottom, double top);
 
 // O'Neil's original constants, for a medium of scale height H in [bottom, top].
