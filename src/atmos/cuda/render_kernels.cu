@@ -5,8 +5,19 @@
 #include <cuda_runtime.h>
 
 #include "models/empty.h"
+#include "models/flat.h"
 #include "models/naive.h"
 #include "models/reference.h"
+#include "models/oneil.h"
+#include "models/preetham.h"
+#include "models/raymarched.h"
+#include "models/schuler.h"
+#include "models/transmittance_chapman.h"
+#include "models/transmittance_erfc.h"
+#include "models/transmittance_flat.h"
+#include "models/transmittance_oneil.h"
+#include "models/transmittance_polynomial.h"
+#include "models/transmittance_reference.h"
 #include "render/render.h"
 
 namespace atmos {
@@ -38,6 +49,33 @@ template cudaError_t LaunchRender<ReferenceEvaluator>(const ReferenceEvaluator&,
                                                       float*, cudaStream_t);
 template cudaError_t LaunchRender<NaiveEvaluator>(const NaiveEvaluator&, const PixelSetup&, float*,
                                                   cudaStream_t);
+
+template cudaError_t LaunchRender<FlatEvaluator>(const FlatEvaluator&, const PixelSetup&, float*,
+                                                 cudaStream_t);
+template cudaError_t LaunchRender<RaymarchedEvaluator>(const RaymarchedEvaluator&,
+                                                       const PixelSetup&, float*, cudaStream_t);
+template cudaError_t LaunchRender<SchulerEvaluator>(const SchulerEvaluator&, const PixelSetup&,
+                                                    float*, cudaStream_t);
+template cudaError_t LaunchRender<OneilEvaluator>(const OneilEvaluator&, const PixelSetup&, float*,
+                                                  cudaStream_t);
+template cudaError_t LaunchRender<PreethamEvaluator>(const PreethamEvaluator&, const PixelSetup&,
+                                                     float*, cudaStream_t);
+template cudaError_t LaunchRender<TransmittanceEvaluator<ReferenceTransmittanceOptics>>(
+    const TransmittanceEvaluator<ReferenceTransmittanceOptics>&, const PixelSetup&, float*,
+    cudaStream_t);
+template cudaError_t LaunchRender<TransmittanceEvaluator<FlatOptics>>(
+    const TransmittanceEvaluator<FlatOptics>&, const PixelSetup&, float*, cudaStream_t);
+template cudaError_t LaunchRender<TransmittanceEvaluator<ErfcTransmittanceOptics>>(
+    const TransmittanceEvaluator<ErfcTransmittanceOptics>&, const PixelSetup&, float*,
+    cudaStream_t);
+template cudaError_t LaunchRender<TransmittanceEvaluator<ChapmanTransmittanceOptics>>(
+    const TransmittanceEvaluator<ChapmanTransmittanceOptics>&, const PixelSetup&, float*,
+    cudaStream_t);
+template cudaError_t LaunchRender<TransmittanceEvaluator<OneilOptics>>(
+    const TransmittanceEvaluator<OneilOptics>&, const PixelSetup&, float*, cudaStream_t);
+template cudaError_t LaunchRender<TransmittanceEvaluator<PolynomialTransmittanceOptics>>(
+    const TransmittanceEvaluator<PolynomialTransmittanceOptics>&, const PixelSetup&, float*,
+    cudaStream_t);
 
 }  // namespace cuda
 }  // namespace atmos

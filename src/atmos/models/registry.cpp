@@ -7,8 +7,19 @@
 #include "atmos/error.h"
 #include "atmos/model.h"
 #include "models/empty.h"
+#include "models/flat.h"
 #include "models/naive.h"
 #include "models/reference.h"
+#include "models/oneil.h"
+#include "models/preetham.h"
+#include "models/raymarched.h"
+#include "models/schuler.h"
+#include "models/transmittance_chapman.h"
+#include "models/transmittance_erfc.h"
+#include "models/transmittance_flat.h"
+#include "models/transmittance_oneil.h"
+#include "models/transmittance_polynomial.h"
+#include "models/transmittance_reference.h"
 
 namespace atmos {
 
@@ -30,6 +41,17 @@ const std::vector<Entry>& Registry() {
         MakeEntry<EmptyModel>(),
         MakeEntry<NaiveModel>(),
         MakeEntry<ReferenceModel>(),
+        MakeEntry<OneilModel>(),
+        MakeEntry<SchulerModel>(),
+        MakeEntry<FlatModel>(),
+        MakeEntry<RaymarchedModel>(),
+        MakeEntry<PreethamModel>(),
+        MakeEntry<TransmittanceReferenceModel>(),
+        MakeEntry<TransmittanceFlatModel>(),
+        MakeEntry<TransmittanceErfcModel>(),
+        MakeEntry<TransmittanceChapmanModel>(),
+        MakeEntry<TransmittanceOneilModel>(),
+        MakeEntry<TransmittancePolynomialModel>(),
     };
     return entries;
 }

@@ -1,0 +1,25 @@
+#include "models/flat.h"
+
+namespace atmos {
+
+ModelInfo FlatModel::StaticInfo() {
+    ModelInfo info;
+    info.name = "flat";
+    info.title = "Flat / homogeneous-sphere single scattering (seed 003 s. 10)";
+    info.citation =
+        "Jodie 2019; Rapp-Arraras & Domingo-Santos 2011; seed 003 sections 10.1-10.5 "
+        "(Eq. 45-55, 59), 11.2.9";
+    info.summary =
+        "closed-form single scattering over one segment, homogeneous-sphere optical depth, "
+        "ozone shell";
+    return info;
+}
+
+FlatModel::FlatModel(const ModelOptions&) : info_(StaticInfo()) { Prepare(EarthAtmosphere()); }
+
+void FlatModel::Prepare(const AtmosphereParameters& atmosphere) {
+    atm_ = atmosphere;
+    evaluator_.optics.m = MakeAnalyticMedia(atmosphere);
+}
+
+}  // namespace atmos

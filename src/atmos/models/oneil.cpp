@@ -1,0 +1,66 @@
+#include "models/oneil.h"
+
+#include "physics/analytic_fit.h"
+
+namespace atmos {
+
+OneilOptics MakeOneilOptics(const AtmosphereParameters& atmosphere, bool refit) {
+    OneilOptics o;
+    o.m = MakeAnalyticMedia(atmosphere);
+    const double bottom = atmosphere.bottom_radius;
+    const double top = atmosphere.top_radius;
+    if (refit) {
+        o.rayleigh = FitOneilScale(o.m.rayleigh_H, bottom, top);
+        o.mie = FitOneilScale(o.m.mie_H, bottom, top);
+    } else {
+        // O'Neil's single scale depth, 0.25 of the thickness, for both media.
+        const double H = 0.25 * (top - bottom);
+        o.m.rayleigh_H = H;
+        o.m.mie_H = H;
+        o.rayleigh = OriginalOneilScale(H, bottom, top);
+        o.mie = OriginalOneilScale(H, bottom, top);
+    }
+    return o;
+}
+
+ModelInfo OneilModel::StaticInfo() {
+    ModelInfo info;
+    info.name = "oneil";
+    info.title = "O'Neil 2005 (GPU Gems 2 ch. 16), per pixel";
+    info.citation = "O'Neil 2005, GPU Gems 2 ch. 16; seed 001; seed 003 section 5.1 (Eq. 17)";
+    info.summary =
+        "single scattering, midpoint rule with the fitted scale() optical depth; scale() "
+        "refitted per atmosphere in Prepare(); no ozone";
+    info.capabilities.precomputed = true;
+    info.options = {
+        {"steps",
+         ModelOptionSpec::Type::kInteger,
+         "5",
+         "view-ray samples (his nSamples)",
+         1,
+         1e5,
+         {}},
+        {"fit",
+         ModelOptionSpec::Type::kChoice,
+         "refit",
+         "scale() constants: refit (least squares per medium) or original (O'Neil's, scale "
+         "depth 0.25)",
+         0,
+         0,
+         {"refit", "original"}},
+    };
+    return info;
+}
+
+OneilModel::OneilModel(const ModelOptions& options) : info_(StaticInfo()) {
+    evaluator_.steps = options.GetInt("steps");
+    refit_ = options.GetText("fit") == "refit";
+    Prepare(EarthAtmosphere());
+}
+
+void OneilModel::Prepare(const AtmosphereParameters& atmosphere) {
+    atm_ = atmosphere;
+    evaluator_.optics = MakeOneilOptics(atmosphere, refit_);
+}
+
+}  // namespace atmos

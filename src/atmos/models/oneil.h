@@ -1,0 +1,164 @@
+// atmos model `oneil`: O'Neil's real-time single scattering (GPU Gems 2,
+// chapter 16, "Accurate Atmospheric Scattering", 2005), evaluated per pixel.
+//
+// Source: O'Neil 2005 as seed 001 presents it (vertex shader "SkyFromAtmosphere":
+// midpoint rule over the view ray, optical depth from the fitted scale()
+// function, fragment-shader phase functions) and seed 003 section 5.1 (Eq. 17).
+//
+// Implements: `steps` midpoint samples x_i of the part of the view ray inside
+// the atmosphere (5 by default, O'Neil's outer integral; cameras in space start
+// where the ray enters, as his SkyFromSpace shader). At each sample
+//   attenuation = exp(-(beta_R (l_R,light + l_R,view) + beta_M^ext (l_M,light + l_M,view)))
+//   L += attenuation * (beta_R^s rho_R(x_i) P_R(nu) + beta_M^s rho_M(x_i) P_M(nu)) ds
+// with every optical length from scale(): l(x, mu) = L_atm exp(-h/H) (H/L_atm)
+// exp(p(1 - mu)) to infinity (physics/analytic_optical_depth.h, OneilScale),
+// the view part as a difference of two such lengths (camera to x_i).
+//
+// Mapping from our canonical parameters to O'Neil's inputs (documented in
+// docs/models.md):
+//   * fInnerRadius, fOuterRadius        = bottom_radius, top_radius (metres, not
+//                                         his 10 / 10.25 units);
+//   * fScaleDepth (0.25 of the thickness) = each medium's scale height H / L_atm:
+//     `--fit refit` (default) gives Rayleigh and Mie their own H and their own
+//     least-squares refit of p (Prepare(), physics/analytic_fit.h); `--fit
+//     original` keeps his constants and his single scale depth 0.25 L_atm for
+//     both media (exact only for L_atm = 2.5% of the radius);
+//   * 4 pi Kr / lambda^4 (his Rayleigh out-scattering per unit length, with the
+//     1/lambda^4 ratio over wavelengths 650, 570, 475 nm) = rayleigh_scattering
+//     per metre, per channel (the ratio between our channels plays the role
+//     of his 1/lambda^4); Kr ESun F_R = beta_R^s E P_R with his phase
+//     0.75 (1 + cos^2) = 4 pi P_R;
+//   * 4 pi Km = mie_extinction for out-scattering and Km F_M = mie_scattering
+//     P_M for in-scattering (he has no absorption: with extinction =
+//     scattering the two coincide); his g = -0.99 (negative = forward in his
+//     convention) is our mie_phase_g with the opposite sign; the phase is the
+//     same Cornette-Shanks form;
+//   * ESun = the solar irradiance: the output is per unit irradiance, as every
+//     model's.
+// No ozone (O'Neil has none).
+//
+// Output: radiance per unit solar irradiance (1/sr); transmittance of the view
+// segment (Rayleigh + Mie). Ground: a/pi max(0, n.s) T_sun T_view.
+// Valid: where scale() fits (rays above the horizon, see the tests); the view
+// ray below the horizon and the light ray from a point whose sun is below its
+// horizon use the decomposition of SegmentFromToInfinity / Eq. 53 with scale()
+// at mu >= 0 only. Deviation: O'Neil's shaders evaluate scale() for negative
+// cosines too (the polynomial extrapolated past x = 1, which a refit does not
+// control) and switch shader by camera position; per-pixel evaluation here
+// (no vertex interpolation), in double.
+#pragma once
+
+#include "atmos/atmosphere.h"
+#include "atmos/model.h"
+#include "physics/analytic_media.h"
+#include "physics/analytic_optical_depth.h"
+#include "physics/geometry.h"
+#include "physics/phase.h"
+#include "render/render.h"
+
+namespace atmos {
+
+// scale() as a function of (r, mu >= 0) for SegmentFromToInfinity.
+struct OneilLength {
+    OneilScale s;
+    double bottom;
+    ATMOS_HD double operator()(double r, double mu) const {
+        return s.LengthToInfinity(r, mu, bottom);
+    }
+};
+
+// O'Neil's optical lengths for the two media.
+struct OneilOptics {
+    AnalyticMedia m;
+    OneilScale rayleigh, mie;
+
+    // To infinity from p along direction cosine mu (any sign: Eq. 53's
+    // decomposition below the horizon).
+    ATMOS_HD double ToInfinity(const OneilScale& s, double r, double mu) const {
+        if (mu >= 0.0) return s.LengthToInfinity(r, mu, m.bottom);
+        const double r_c = r * SafeSqrt(1.0 - mu * mu);
+        return ClampLength(2.0 * s.LengthToInfinity(r_c, 0.0, m.bottom) -
+                           s.LengthToInfinity(r, -mu, m.bottom));
+    }
+    ATMOS_HD Vec3d LightDepth(const Vec3d& p, const Vec3d& sun) const {
+        const double r = Length(p);
+        const double mu_s = ClampCosine(Dot(p, sun) / r);
+        return m.rayleigh_scattering * ToInfinity(rayleigh, r, mu_s) +
+               m.mie_extinction * ToInfinity(mie, r, mu_s);
+    }
+    ATMOS_HD Vec3d SegmentDepth(const Vec3d& origin, const Vec3d& dir, double t0, double t1) const {
+        const Vec3d p = origin + dir * t0;
+        const double r = Length(p);
+        const double mu = ClampCosine(Dot(p, dir) / r);
+        const double d = Max(t1 - t0, 0.0);
+        return m.rayleigh_scattering *
+                   SegmentFromToInfinity(OneilLength{rayleigh, m.bottom}, r, mu, d) +
+               m.mie_extinction * SegmentFromToInfinity(OneilLength{mie, m.bottom}, r, mu, d);
+    }
+};
+
+struct OneilEvaluator {
+    OneilOptics optics;
+    int steps = 5;
+
+    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                                bool want_ground) const {
+        const AnalyticMedia& m = optics.m;
+        RayResult out;
+        out.transmittance = Rgb(1.0f);
+        const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, m.bottom, m.top);
+        out.hits_ground = seg.hits_ground;
+        if (!seg.inside) return out;
+        const double ds = (seg.t_end - seg.t_start) / steps;
+        Vec3d sum_r, sum_m;
+        for (int i = 0; i < steps; ++i) {
+            const double t = seg.t_start + (i + 0.5) * ds;
+            const Vec3d p = camera + dir * t;
+            const double h = Length(p) - m.bottom;
+            const double rho_r = SafeExp(-h / m.rayleigh_H);
+            const double rho_m = SafeExp(-h / m.mie_H);
+            const Vec3d tau =
+                optics.SegmentDepth(camera, dir, seg.t_start, t) + optics.LightDepth(p, sun);
+            const Vec3d attenuation = Exp(-tau);
+            sum_r += attenuation * (rho_r * ds);
+            sum_m += attenuation * (rho_m * ds);
+        }
+        const double nu = Dot(dir, sun);
+        const Vec3d sky = m.rayleigh_scattering * sum_r * RayleighPhase(nu) +
+                          m.mie_scattering * sum_m * CornetteShanksPhase(m.mie_g, nu);
+        const Vec3d t_view = Exp(-optics.SegmentDepth(camera, dir, seg.t_start, seg.t_end));
+        out.sky = Rgb(sky);
+        out.transmittance = Rgb(t_view);
+        if (want_ground && seg.hits_ground && MaxComponent(m.ground_albedo) > 0.0) {
+            const Vec3d g = camera + dir * seg.t_end;
+            const double cos_sun = Dot(Normalize(g), sun);
+            if (cos_sun > 0.0) {
+                out.ground = Rgb(m.ground_albedo * (cos_sun / kPi) *
+                                 Exp(-optics.LightDepth(g, sun)) * t_view);
+            }
+        }
+        return out;
+    }
+};
+
+// Builds O'Neil's optics for an atmosphere: `refit` fits scale() per medium
+// (physics/analytic_fit.h); otherwise his constants with scale depth 0.25.
+OneilOptics MakeOneilOptics(const AtmosphereParameters& atmosphere, bool refit);
+
+class OneilModel : public EvaluatorModel<OneilModel> {
+  public:
+    explicit OneilModel(const ModelOptions& options);
+    static ModelInfo StaticInfo();
+    const ModelInfo& Info() const override { return info_; }
+    void Prepare(const AtmosphereParameters& atmosphere) override;
+    OneilEvaluator MakeEvaluator() const { return evaluator_; }
+    const AtmosphereParameters& atmosphere() const { return atm_; }
+
+  private:
+    ModelInfo info_;
+    AtmosphereParameters atm_;
+    bool refit_ = true;
+    OneilEvaluator evaluator_;
+};
+
+}  // namespace atmos

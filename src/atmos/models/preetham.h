@@ -1,0 +1,164 @@
+// atmos model `preetham`: the analytic daylight model of Preetham, Shirley and
+// Smits 1999 ("A Practical Analytic Model for Daylight", SIGGRAPH 99).
+//
+// Source: the paper (Perez et al. 1993 distribution, its Eq. 3 / appendix A.2:
+// the Perez coefficients of Y, x, y as linear functions of turbidity T; zenith
+// luminance Y_z = (4.0453 T - 4.9710) tan(chi) - 0.2155 T + 2.4192 kcd/m^2 with
+// chi = (4/9 - T/120)(pi - 2 theta_s); zenith chromaticities x_z, y_z as
+// [T^2 T 1] M [theta_s^3 theta_s^2 theta_s 1]^T), as seed 003 section 5.3
+// (Eq. 32-34) and section 11.2.5 use it.
+//
+// Implements: Y = Y_z F(theta, gamma) / F(0, theta_s) and the same for x and y
+// (Eq. 33-34), F(theta, gamma) = (1 + A exp(B / cos theta))(1 + C exp(D gamma)
+// + E cos^2 gamma) (Eq. 32); xyY -> XYZ -> linear sRGB (IEC 61966-2-1 matrix,
+// D65). theta is the view's zenith angle, theta_s the sun's, gamma the angle
+// between them, all at the camera.
+//
+// Radiance scale (so it is comparable with the physical models, which output
+// radiance per unit solar irradiance, 1/sr): luminance in cd/m^2 = lm/(m^2 sr)
+// divided by the extraterrestrial solar illuminance 128 klx (128e3 lm/m^2, the
+// value used by Perez et al. and the IES): L = Y[kcd/m^2] * 1000 / 128000.
+// A grey sky of luminance Y gives RGB (L, L, L).
+//
+// Valid: a viewer on the ground, the sun above the horizon, views above the
+// horizon, turbidity about 2 to 10 (`--turbidity`, default 2.5). Capabilities
+// say so (space_views = false, sun_below_horizon = false). Outside, it renders
+// something defined: a camera above the ground is treated as on the ground
+// (same directions); a sun below the horizon is raised to the horizon (theta_s
+// = 90 deg); a view below the horizon that does not hit the ground uses the
+// horizon (cos theta clamped to 0.001); a ray that hits the ground, or misses
+// the atmosphere, gets no sky. It has no transmittance (capabilities:
+// transmittance = false; 1 is reported for sky rays) and no ground term.
+#pragma once
+
+#include "atmos/atmosphere.h"
+#include "atmos/model.h"
+#include "physics/geometry.h"
+#include "render/render.h"
+
+namespace atmos {
+
+// The five Perez coefficients.
+struct PerezCoefficients {
+    double a, b, c, d, e;
+};
+
+// Eq. 32.
+ATMOS_HD inline double PerezF(const PerezCoefficients& k, double cos_theta, double gamma) {
+    const double cos_gamma = cos(gamma);
+    return (1.0 + k.a * Exp(k.b / cos_theta)) *
+           (1.0 + k.c * Exp(k.d * gamma) + k.e * cos_gamma * cos_gamma);
+}
+
+// Preetham et al. 1999, appendix A.2: distribution coefficients of Y, x, y.
+inline PerezCoefficients PreethamLuminanceCoefficients(double T) {
+    return {0.1787 * T - 1.4630, -0.3554 * T + 0.4275, -0.0227 * T + 5.3251, 0.1206 * T - 2.5771,
+            -0.0670 * T + 0.3703};
+}
+inline PerezCoefficients PreethamXCoefficients(double T) {
+    return {-0.0193 * T - 0.2592, -0.0665 * T + 0.0008, -0.0004 * T + 0.2125, -0.0641 * T - 0.8989,
+            -0.0033 * T + 0.0452};
+}
+inline PerezCoefficients PreethamYCoefficients(double T) {
+    return {-0.0167 * T - 0.2608, -0.0950 * T + 0.0092, -0.0079 * T + 0.2102, -0.0441 * T - 1.6537,
+            -0.0109 * T + 0.0529};
+}
+
+// Preetham et al. 1999, appendix A.2: zenith luminance (kcd/m^2) and
+// chromaticity for turbidity T and sun zenith angle theta_s (radians).
+double PreethamZenithLuminance(double T, double theta_s);
+double PreethamZenithX(double T, double theta_s);
+double PreethamZenithY(double T, double theta_s);
+
+// Extraterrestrial solar illuminance (lm/m^2) the radiance scale divides by.
+constexpr double kPreethamSolarIlluminance = 128e3;
+
+struct PreethamEvaluator {
+    double bottom = 6360e3, top = 6460e3;
+    double turbidity = 2.5;
+    PerezCoefficients kY{}, kx{}, ky{};
+
+    // Perez normalisation and zenith values depend on the sun only; they are
+    // evaluated per ray (cheap) so the evaluator needs no per-view state.
+    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                                bool) const {
+        RayResult out;
+        out.transmittance = Rgb(1.0f);
+        const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, bottom, top);
+        out.hits_ground = seg.hits_ground;
+        if (seg.hits_ground) out.transmittance = Rgb(0.0f);
+        if (!seg.inside || seg.hits_ground) return out;
+        const Vec3d up = Normalize(camera);
+        // Sun raised to the horizon when below it.
+        double cos_s = Dot(sun, up);
+        Vec3d s = sun;
+        if (cos_s < 0.0) {
+            const Vec3d horizontal = sun - up * cos_s;
+            const double len = Length(horizontal);
+            s = len > 1e-9 ? horizontal / len : Normalize(Cross(up, Vec3d(1.0, 0.0, 0.0)));
+            cos_s = 0.0;
+        }
+        const double theta_s = acos(Clamp(cos_s, -1.0, 1.0));
+        const double cos_theta = Max(Dot(dir, up), 0.001);
+        const double gamma = acos(Clamp(Dot(dir, s), -1.0, 1.0));
+        const double Yz = ZenithLuminance(theta_s);
+        const double xz = ZenithChromaticity(theta_s, true);
+        const double yz = ZenithChromaticity(theta_s, false);
+        const double Y = Yz * PerezF(kY, cos_theta, gamma) / PerezF(kY, 1.0, theta_s);
+        const double x = xz * PerezF(kx, cos_theta, gamma) / PerezF(kx, 1.0, theta_s);
+        const double y = yz * PerezF(ky, cos_theta, gamma) / PerezF(ky, 1.0, theta_s);
+        // xyY -> XYZ (radiance units: kcd/m^2 -> per unit solar irradiance).
+        const double L = Max(Y, 0.0) * 1000.0 / kPreethamSolarIlluminance;
+        const double yy = Max(y, 1e-6);
+        const double X = x / yy * L;
+        const double Z = (1.0 - x - y) / yy * L;
+        // XYZ -> linear sRGB (IEC 61966-2-1).
+        const double R = 3.2404542 * X - 1.5371385 * L - 0.4985314 * Z;
+        const double G = -0.9692660 * X + 1.8760108 * L + 0.0415560 * Z;
+        const double B = 0.0556434 * X - 0.2040259 * L + 1.0572252 * Z;
+        out.sky = Rgb(static_cast<float>(Max(R, 0.0)), static_cast<float>(Max(G, 0.0)),
+                      static_cast<float>(Max(B, 0.0)));
+        return out;
+    }
+
+    ATMOS_HD double ZenithLuminance(double theta_s) const {
+        const double T = turbidity;
+        const double chi = (4.0 / 9.0 - T / 120.0) * (kPi - 2.0 * theta_s);
+        return Max((4.0453 * T - 4.9710) * tan(chi) - 0.2155 * T + 2.4192, 0.0);
+    }
+    ATMOS_HD double ZenithChromaticity(double theta_s, bool x) const {
+        // Preetham et al. 1999 appendix A.2, rows for T^2, T, 1; columns for
+        // theta_s^3, theta_s^2, theta_s, 1.
+        const double mx[3][4] = {{0.00166, -0.00375, 0.00209, 0.0},
+                                 {-0.02903, 0.06377, -0.03202, 0.00394},
+                                 {0.11693, -0.21196, 0.06052, 0.25886}};
+        const double my[3][4] = {{0.00275, -0.00610, 0.00317, 0.0},
+                                 {-0.04214, 0.08970, -0.04153, 0.00516},
+                                 {0.15346, -0.26756, 0.06670, 0.26688}};
+        const double T = turbidity;
+        const double t[3] = {T * T, T, 1.0};
+        const double s[4] = {theta_s * theta_s * theta_s, theta_s * theta_s, theta_s, 1.0};
+        double sum = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 4; ++j) sum += t[i] * (x ? mx[i][j] : my[i][j]) * s[j];
+        }
+        return sum;
+    }
+};
+
+class PreethamModel : public EvaluatorModel<PreethamModel> {
+  public:
+    explicit PreethamModel(const ModelOptions& options);
+    static ModelInfo StaticInfo();
+    const ModelInfo& Info() const override { return info_; }
+    void Prepare(const AtmosphereParameters& atmosphere) override;
+    PreethamEvaluator MakeEvaluator() const { return evaluator_; }
+    const AtmosphereParameters& atmosphere() const { return atm_; }
+
+  private:
+    ModelInfo info_;
+    AtmosphereParameters atm_;
+    PreethamEvaluator evaluator_;
+};
+
+}  // namespace atmos

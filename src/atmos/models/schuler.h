@@ -1,0 +1,116 @@
+// atmos model `schuler`: the naive single-scattering integrator with the light
+// ray's optical depth from Schuler's Chapman-function approximation.
+//
+// Source: Schuler 2012, "An Approximation to the Chapman Grazing-Incidence
+// Function for Atmospheric Scattering" (GPU Pro 3), as seed 003 section 5.1
+// (Eq. 22-25) gives it and section 11.2.7 uses it.
+//
+// Implements: the view ray of `naive` (midpoint rule, `steps` samples, the
+// view optical depth accumulated numerically to each sample's midpoint), and
+// at each sample the light's optical depth to infinity
+//   tau_light = beta_R H_R Ch_R + beta_M^ext H_M Ch_M   (Eq. 24-25)
+// instead of the inner loop. A light ray that hits the ground contributes
+// nothing (the naive integrator's planet-shadow test is kept).
+//
+// No ozone: the Chapman function describes exponential media only, so, as the
+// thesis's version, this model has no ozone absorption anywhere (view or
+// light); its sky is therefore a little brighter and less blue at sunset.
+//
+// Output: radiance per unit solar irradiance (1/sr); transmittance of the view
+// segment (Rayleigh + Mie). Ground: a/pi max(0, n.s) T_sun T_view.
+// `--chapman-unit seed|half-height`: Eq. 25 as the seed prints it (default) or
+// in Schuler's own unit, the 50% height H ln 2 (physics/analytic_optical_depth.h).
+// Valid: any camera and sun; error of the approximation: tests/analytic_test.cpp
+// (Chapman.*) and docs/models.md.
+#pragma once
+
+#include "atmos/atmosphere.h"
+#include "atmos/model.h"
+#include "physics/analytic_media.h"
+#include "physics/analytic_optical_depth.h"
+#include "physics/density.h"
+#include "physics/geometry.h"
+#include "physics/phase.h"
+#include "render/render.h"
+
+namespace atmos {
+
+struct SchulerEvaluator {
+    AtmosphereParameters atm;  // profiles for the view ray
+    AnalyticMedia m;           // scale heights and coefficients for the light
+    int steps = 16;
+    double chapman_unit = kChapmanSeedUnit;  // `--chapman-unit`
+
+    // Rayleigh + Mie extinction (no ozone) at an altitude.
+    ATMOS_HD Vec3d ExtinctionAt(double altitude, double* rho_r, double* rho_m) const {
+        *rho_r = GetProfileDensity(atm.rayleigh_density, altitude);
+        *rho_m = GetProfileDensity(atm.mie_density, altitude);
+        return atm.rayleigh_scattering * *rho_r + atm.mie_extinction * *rho_m;
+    }
+
+    // Chapman light depth (Eq. 24-25), or false if the light ray hits the ground.
+    ATMOS_HD bool LightDepth(const Vec3d& p, const Vec3d& sun, Vec3d* tau) const {
+        const double r = Length(p);
+        const double mu_s = ClampCosine(Dot(p, sun) / r);
+        if (RayIntersectsGround(r, mu_s, m.bottom)) return false;
+        *tau = m.rayleigh_scattering *
+                   ChapmanLengthToInfinity(r, mu_s, m.rayleigh_H, m.bottom, chapman_unit) +
+               m.mie_extinction * ChapmanLengthToInfinity(r, mu_s, m.mie_H, m.bottom, chapman_unit);
+        return true;
+    }
+
+    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                                bool want_ground) const {
+        RayResult out;
+        out.transmittance = Rgb(1.0f);
+        const AtmosphereSegment seg =
+            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
+        out.hits_ground = seg.hits_ground;
+        if (!seg.inside) return out;
+        const double ds = (seg.t_end - seg.t_start) / steps;
+        const double nu = Dot(dir, sun);
+        Vec3d tau_view, sum_r, sum_m;
+        for (int i = 0; i < steps; ++i) {
+            const Vec3d p = camera + dir * (seg.t_start + (i + 0.5) * ds);
+            double rho_r, rho_m;
+            const Vec3d ext = ExtinctionAt(Length(p) - atm.bottom_radius, &rho_r, &rho_m);
+            const Vec3d tau_mid = tau_view + ext * (0.5 * ds);
+            tau_view += ext * ds;
+            Vec3d tau_sun;
+            if (!LightDepth(p, sun, &tau_sun)) continue;
+            const Vec3d t = Exp(-(tau_mid + tau_sun));
+            sum_r += t * (rho_r * ds);
+            sum_m += t * (rho_m * ds);
+        }
+        const Vec3d sky = atm.rayleigh_scattering * sum_r * RayleighPhase(nu) +
+                          atm.mie_scattering * sum_m * CornetteShanksPhase(atm.mie_phase_g, nu);
+        const Vec3d t_view = Exp(-tau_view);
+        out.sky = Rgb(sky);
+        out.transmittance = Rgb(t_view);
+        if (want_ground && seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0) {
+            const Vec3d g = camera + dir * seg.t_end;
+            const double cos_sun = Dot(Normalize(g), sun);
+            Vec3d tau_sun;
+            if (cos_sun > 0.0 && LightDepth(g, sun, &tau_sun)) {
+                out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * Exp(-tau_sun) * t_view);
+            }
+        }
+        return out;
+    }
+};
+
+class SchulerModel : public EvaluatorModel<SchulerModel> {
+  public:
+    explicit SchulerModel(const ModelOptions& options);
+    static ModelInfo StaticInfo();
+    const ModelInfo& Info() const override { return info_; }
+    void Prepare(const AtmosphereParameters& atmosphere) override;
+    SchulerEvaluator MakeEvaluator() const { return evaluator_; }
+    const AtmosphereParameters& atmosphere() const { return evaluator_.atm; }
+
+  private:
+    ModelInfo info_;
+    SchulerEvaluator evaluator_;
+};
+
+}  // namespace atmos

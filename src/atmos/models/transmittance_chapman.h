@@ -1,0 +1,59 @@
+// atmos model `transmittance-chapman`: the view ray's transmittance from
+// Schuler 2012's Chapman-function approximation.
+//
+// Source: seed 003 section 5.1, Eq. 22-25. Implements: each exponential
+// medium's optical length to infinity from ChapmanLengthToInfinity (Eq. 24-25,
+// mu >= 0 branch), segments by SegmentFromToInfinity (which reproduces Eq. 24's
+// complement branch for rays that pass the tangent point, and uses two upward
+// rays for segments to the ground); T = exp(-tau). No ozone (as `schuler`).
+// `--chapman-unit seed` (default) is Eq. 25 as printed (unit: the scale
+// height); `half-height` is Schuler's own unit, the 50% height H ln 2.
+// Output: transmittance only. Valid: as the approximation (error: docs/models.md).
+#pragma once
+
+#include "models/transmittance_common.h"
+#include "physics/analytic_media.h"
+
+namespace atmos {
+
+struct ChapmanUpLength {
+    double H, bottom, unit;
+    ATMOS_HD double operator()(double r, double mu) const {
+        return ChapmanLengthToInfinity(r, mu, H, bottom, unit);
+    }
+};
+
+struct ChapmanTransmittanceOptics {
+    AnalyticMedia m;
+    double unit = kChapmanSeedUnit;  // `--chapman-unit`: see ChapmanLengthToInfinity
+
+    ATMOS_HD Vec3d SegmentDepth(const Vec3d& origin, const Vec3d& dir, double t0, double t1) const {
+        const Vec3d p = origin + dir * t0;
+        const double r = Length(p);
+        const double mu = ClampCosine(Dot(p, dir) / r);
+        const double d = Max(t1 - t0, 0.0);
+        return m.rayleigh_scattering *
+                   SegmentFromToInfinity(ChapmanUpLength{m.rayleigh_H, m.bottom, unit}, r, mu, d) +
+               m.mie_extinction *
+                   SegmentFromToInfinity(ChapmanUpLength{m.mie_H, m.bottom, unit}, r, mu, d);
+    }
+};
+
+class TransmittanceChapmanModel
+    : public TransmittanceModel<TransmittanceChapmanModel, ChapmanTransmittanceOptics> {
+  public:
+    explicit TransmittanceChapmanModel(const ModelOptions& options);
+    static ModelInfo StaticInfo();
+    ChapmanTransmittanceOptics MakeOptics(const AtmosphereParameters& atmosphere) const {
+        return ChapmanTransmittanceOptics{MakeAnalyticMedia(atmosphere), unit_};
+    }
+
+  private:
+    double unit_ = kChapmanSeedUnit;
+};
+
+// The `--chapman-unit` option shared by `schuler` and `transmittance-chapman`.
+ModelOptionSpec ChapmanUnitOption();
+double ChapmanUnitFromOptions(const ModelOptions& options);
+
+}  // namespace atmos
