@@ -5,6 +5,7 @@
 #include <cuda_runtime.h>
 
 #include "models/empty.h"
+#include "models/hillaire.h"
 #include "models/naive.h"
 #include "render/render.h"
 
@@ -35,6 +36,8 @@ template cudaError_t LaunchRender<EmptyEvaluator>(const EmptyEvaluator&, const P
                                                   cudaStream_t);
 template cudaError_t LaunchRender<NaiveEvaluator>(const NaiveEvaluator&, const PixelSetup&, float*,
                                                   cudaStream_t);
+template cudaError_t LaunchRender<HillaireEvaluator>(const HillaireEvaluator&, const PixelSetup&,
+                                                     float*, cudaStream_t);
 
 }  // namespace cuda
 }  // namespace atmos

@@ -7,6 +7,7 @@
 #include "atmos/error.h"
 #include "atmos/model.h"
 #include "models/empty.h"
+#include "models/hillaire.h"
 #include "models/naive.h"
 
 namespace atmos {
@@ -28,6 +29,7 @@ const std::vector<Entry>& Registry() {
     static const std::vector<Entry> entries = {
         MakeEntry<EmptyModel>(),
         MakeEntry<NaiveModel>(),
+        MakeEntry<HillaireModel>(),
     };
     return entries;
 }
