@@ -81,6 +81,22 @@ ModelInfo HillaireModel::StaticInfo() {
          1,
          1e4,
          {}},
+        {"segment-offset",
+         T::kReal,
+         "0.3",
+         "position of the sample inside each march segment (0.3: the paper's demo, 0.5: "
+         "midpoint)",
+         0,
+         1,
+         {}},
+        {"ground-path",
+         T::kChoice,
+         "aerial-perspective",
+         "in-scatter and transmittance of ground rays (camera inside): from the aerial-"
+         "perspective volume or the sky-view table",
+         0,
+         0,
+         {"aerial-perspective", "sky-view"}},
         {"sample-path",
          T::kChoice,
          "table",
@@ -99,6 +115,8 @@ HillaireModel::HillaireModel(const ModelOptions& options) : info_(StaticInfo()) 
     transmittance_steps_ = options.GetInt("transmittance-steps");
     evaluator_.ap_metres_per_slice = options.GetReal("ap-km-per-slice") * 1000.0;
     ap_steps_per_slice_ = options.GetInt("ap-steps-per-slice");
+    evaluator_.segment_offset = options.GetReal("segment-offset");
+    evaluator_.ground_from_ap = options.GetText("ground-path") == "aerial-perspective";
     sample_with_tables_ = options.GetText("sample-path") == "table";
 }
 
@@ -176,7 +194,7 @@ void HillaireModel::BuildMultipleScattering() {
             if (seg.inside) {
                 const double dt = (seg.t_end - seg.t_start) / kHillaireMsSteps;
                 for (int s = 0; s < kHillaireMsSteps; ++s) {
-                    const Vec3d p = x + dir * (seg.t_start + (s + kHillaireSampleOffset) * dt);
+                    const Vec3d p = x + dir * (seg.t_start + (s + e.segment_offset) * dt);
                     const double rp = Length(p);
                     const Densities d = GetDensities(atm, rp - atm.bottom_radius);
                     const Vec3d sigma_s =
@@ -292,7 +310,7 @@ void HillaireModel::Render(const RenderRequest& request, Image* out) const {
     const PixelSetup setup = MakePixelSetup(request, evaluator_.atm);
     const std::unique_ptr<HillaireFrame> frame =
         BuildFrame(request.view.camera, request.view.sun_direction,
-                   static_cast<double>(request.width) / request.height);
+                   static_cast<double>(request.width) / request.height, evaluator_.ground_from_ap);
     last_frame_timings_ = frame->timings;
     out->Resize(request.width, request.height);
     RenderImage(frame->Evaluator(), setup, out->View(), request.show_progress);

@@ -20,7 +20,8 @@
 //    with the isotropic phase p_u = 1/(4 pi), the planet shadow V and the
 //    ground albedo a (Lambertian, lit by the transmitted sun).
 //  * The ray march (paper Eq. 1-3, 11): along the segment inside the atmosphere,
-//    N equal segments sampled at 0.3 of their length (the demo's offset), with
+//    N equal segments each sampled at a fraction `--segment-offset` of its
+//    length (0.3, the demo's SampleSegmentT; 0.5 is the midpoint rule), with
 //      S = T_sun V (sigma_R P_R(nu) + sigma_M P_M(nu)) + (sigma_R + sigma_M) Psi_ms
 //    integrated analytically over each segment at constant coefficients,
 //      L += T_acc (S - S e^(-sigma_t dt)) / sigma_t,  T_acc *= e^(-sigma_t dt)
@@ -44,9 +45,15 @@
 //  * camera inside the atmosphere (r <= top) with frame tables: sky from the
 //    sky-view table, transmittance from the transmittance table; a ray that
 //    hits the ground gets its in-scatter and transmittance from the aerial-
-//    perspective volume when the ground is within the volume's last slice,
-//    otherwise from the sky-view table (its lower half marches to the ground)
-//    and the transmittance table (T(r,mu,d) = T(r_d,-mu_d)/T(r,-mu), seed 004);
+//    perspective volume when the ground is within the volume's last slice
+//    (`--ground-path aerial-perspective`, the default), otherwise from the
+//    sky-view table (its lower half marches to the ground) and the
+//    transmittance table (T(r,mu,d) = T(r_d,-mu_d)/T(r,-mu), seed 004);
+//    `--ground-path sky-view` uses the latter for every ground ray. The
+//    volume is coarse for the planet's own surface: a ground ray's value is
+//    interpolated between froxel columns that either hit the ground earlier
+//    (their values stop growing there) or pass above it through thinner air,
+//    so both bias it low (see tests/hillaire_test.cpp, AerialPerspective*);
 //  * camera outside (orbit, space), or no frame tables: the ray march with
 //    `--steps` (40, the thesis's count) from where the ray enters;
 //  * lit ground (albedo > 0): a/pi max(0, n.s) T_sun(ground) times the view
@@ -98,7 +105,6 @@ constexpr int kHillaireMsSteps = 20;          // the demo's march per direction
 constexpr int kHillaireSkyViewWidth = 192;
 constexpr int kHillaireSkyViewHeight = 108;
 constexpr int kHillaireApSize = 32;                  // x, y and slices
-constexpr double kHillaireSampleOffset = 0.3;        // demo's position of a sample in its segment
 constexpr double kHillaireSkyViewMinAltitude = 1.0;  // m, for the horizon angle
 
 // --- Table mappings (all ATMOS_HD) -----------------------------------------
@@ -204,6 +210,8 @@ struct HillaireEvaluator {
     TableView multiple_scattering;        // 32 x 32, RGB Psi_ms
     int steps = 40;                       // ray march outside the atmosphere / without tables
     bool use_multiple_scattering = true;  // false: single scattering only (tests)
+    double segment_offset = 0.3;          // sample position inside each march segment
+    bool ground_from_ap = true;  // ground rays: aerial perspective (true) or sky-view table
 
     // Per-frame tables (data == nullptr: absent).
     TableView sky_view;          // 192 x 108, RGB
@@ -257,7 +265,7 @@ struct HillaireEvaluator {
         const double phase_m = CornetteShanksPhase(atm.mie_phase_g, nu);
         const double dt = (tb - ta) / n;
         for (int i = 0; i < n; ++i) {
-            const Vec3d p = origin + dir * (ta + (i + kHillaireSampleOffset) * dt);
+            const Vec3d p = origin + dir * (ta + (i + segment_offset) * dt);
             const double r = Length(p);
             const double mu_s = ClampCosine(Dot(p, sun) / r);
             const Densities d = GetDensities(atm, r - atm.bottom_radius);
@@ -344,7 +352,7 @@ struct HillaireEvaluator {
             if (!seg.hits_ground) {
                 L = SkyView(camera, dir, sun);
                 T = Transmittance(r, mu);
-            } else if (!AerialPerspective(dir, seg.t_end, &L, &T)) {
+            } else if (!ground_from_ap || !AerialPerspective(dir, seg.t_end, &L, &T)) {
                 L = SkyView(camera, dir, sun);
                 T = TransmittanceToGround(r, mu, seg.t_end);
             }
