@@ -334,9 +334,9 @@ TEST(Hillaire, AerialPerspectiveMatchesDirectMarch) {
         100.0 * worst_sky);
     EXPECT_LT(worst_centre, 0.03);
     EXPECT_GT(n, 20);
-    EXPECT_LT(sum_l / n, 0.08);
-    EXPECT_LT(worst_l, 0.3);
-    EXPECT_LT(worst_t, 0.12);
+    EXPECT_LT(sum_l / n, 0.01);
+    EXPECT_LT(worst_l, 0.05);
+    EXPECT_LT(worst_t, 0.01);
     EXPECT_LT(sum_sky / n, 0.01);
     EXPECT_LT(worst_sky, 0.03);
 }

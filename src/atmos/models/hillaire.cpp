@@ -285,16 +285,21 @@ std::unique_ptr<HillaireFrame> HillaireModel::BuildFrame(const Camera& camera_fr
         const Vec3d dir = Normalize(camera_frame.forward +
                                     camera_frame.right * ((2.0 * u - 1.0) * tan_y * aspect) +
                                     camera_frame.up * ((1.0 - 2.0 * v) * tan_y));
-        const AtmosphereSegment seg =
-            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
+        // The froxel's ray ignores the ground (points below it are taken at
+        // the ground): a ground ray's value is interpolated between froxel
+        // rays, and a neighbour that stopped at its own ground hit would bias it.
+        double t_in = 0.0, t_out = 0.0;
+        const bool crosses =
+            IntersectSphere(camera, dir, atm.top_radius, &t_in, &t_out) && t_out > 0.0;
+        t_in = Max(t_in, 0.0);
         Vec3d L, T(1.0);
         double t_prev = 0.0;
         for (int k = 0; k < kHillaireApSize; ++k) {
             const double t_k = HillaireApSliceDistance(k, metres_per_slice);
-            if (seg.inside) {
-                const double ta = Clamp(t_prev, seg.t_start, seg.t_end);
-                const double tb = Clamp(t_k, seg.t_start, seg.t_end);
-                e.Integrate(camera, dir, sun, ta, tb, sub, &L, &T);
+            if (crosses) {
+                const double ta = Clamp(t_prev, t_in, t_out);
+                const double tb = Clamp(t_k, t_in, t_out);
+                e.Integrate(camera, dir, sun, ta, tb, sub, &L, &T, true);
             }
             t_prev = t_k;
             scatter.Set(i, j, k, ToTexel(L));
