@@ -13,6 +13,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "atmos/atmosphere.h"
 #include "atmos/image.h"
@@ -117,6 +118,29 @@ void BM_HillaireRenderFrame(benchmark::State& state) {
     for (auto _ : state) model->Render(request, &image);
 }
 BENCHMARK(BM_HillaireRenderFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Nanoseconds per Evaluate() (one view ray) on one thread, over a fixed set of
+// the view's pixel directions: the table path (ground-sunrise) and the ray
+// march (space).
+void BM_HillaireEvaluate(benchmark::State& state) {
+    auto model = PreparedModel();
+    const View view = GetView(kViews[state.range(0)], model->atmosphere());
+    state.SetLabel(view.name);
+    auto frame = model->BuildFrame(view.camera, view.sun_direction, 16.0 / 9.0, true);
+    const HillaireEvaluator e = frame->Evaluator();
+    std::vector<Vec3d> dirs;
+    for (int i = 0; i < 64 * 36; ++i) {
+        dirs.push_back(view.camera.RayDirection(i % 64, i / 64, 64, 36));
+    }
+    size_t i = 0;
+    for (auto _ : state) {
+        RayResult r = e.Evaluate(view.camera.position, dirs[i], view.sun_direction, true);
+        benchmark::DoNotOptimize(r);
+        i = (i + 1) % dirs.size();
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_HillaireEvaluate)->Arg(0)->Arg(3);
 
 }  // namespace
 }  // namespace atmos

@@ -5,7 +5,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <string>
@@ -517,6 +520,29 @@ TEST(Hillaire, SampleTablePathMatchesMarchPath) {
     }
     std::printf("40-step march transmittance, offset 0.3 vs 0.5: max %.1f %%\n",
                 100.0 * worst_offset_t);
+}
+
+TEST(HillaireCli, BakeThenRenderWithLoadMatchesPrepare) {
+    const std::filesystem::path dir = std::filesystem::path(ATMOS_TEST_TMP) / "hillaire_cli";
+    std::filesystem::create_directories(dir);
+    const std::string cli = ATMOS_CLI_PATH;
+    const std::string bake = (dir / "bake").string();
+    const std::string a = (dir / "loaded.npy").string(), b = (dir / "prepared.npy").string();
+    const std::string quiet = " --quiet 2>/dev/null";
+    ASSERT_EQ(std::system((cli + " bake --model hillaire -o " + bake + quiet).c_str()), 0);
+    EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(bake) / "hillaire.json"));
+    const std::string render = cli + " render --model hillaire --view plane-sunrise --size 48x27 ";
+    ASSERT_EQ(std::system((render + "--load " + bake + " -o " + a + quiet).c_str()), 0);
+    ASSERT_EQ(std::system((render + "-o " + b + quiet).c_str()), 0);
+    std::ifstream fa(a, std::ios::binary), fb(b, std::ios::binary);
+    const std::string da((std::istreambuf_iterator<char>(fa)), std::istreambuf_iterator<char>());
+    const std::string db((std::istreambuf_iterator<char>(fb)), std::istreambuf_iterator<char>());
+    EXPECT_FALSE(da.empty());
+    EXPECT_EQ(da, db);  // the baked tables are the prepared ones, bit for bit
+    // A bake of another atmosphere is refused.
+    EXPECT_NE(std::system(
+                  (render + "--load " + bake + " --set ground_albedo=0.3 -o " + a + quiet).c_str()),
+              0);
 }
 
 }  // namespace
