@@ -344,6 +344,51 @@ TEST(Hillaire, AerialPerspectiveMatchesDirectMarch) {
     EXPECT_LT(worst_sky, 0.03);
 }
 
+TEST(Hillaire, LitGroundMatchesDirectIntegration) {
+    // Ground radiance = a/pi (n.s) T_sun(ground) T_view, per path: aerial
+    // perspective (camera inside) and march (camera in space), against optical
+    // depths integrated directly.
+    AtmosphereParameters atm = EarthAtmosphere();
+    atm.ground_albedo = Vec3d(0.3, 0.2, 0.1);
+    const auto model = MakeModel(atm);
+    const Vec3d sun = Dir(std::sin(Radians(40.0)), 0.3);
+    struct Case {
+        Vec3d camera, forward;
+    };
+    const double R = atm.bottom_radius;
+    for (const Case& k : {Case{Vec3d(0, 0, R + 5000.0), Normalize(Vec3d(1, 0, -0.3))},
+                          Case{Vec3d(0, 0, R + 400e3), Vec3d(0, 0, -1)}}) {
+        const Camera cam = MakeCamera(k.camera, k.forward, Vec3d(0, 1, 0), 60.0);
+        const auto f = model->BuildFrame(cam, sun, 1.0, true);
+        const HillaireEvaluator e = f->Evaluator();
+        int hits = 0;
+        for (int y = 2; y < 16; y += 3) {
+            for (int x = 1; x < 16; x += 4) {
+                const Vec3d dir = cam.RayDirection(x, y, 16, 16);
+                const RayResult r = e.Evaluate(k.camera, dir, sun, true);
+                const AtmosphereSegment seg =
+                    ClipToAtmosphere(k.camera, dir, atm.bottom_radius, atm.top_radius);
+                ASSERT_EQ(seg.hits_ground, r.hits_ground);
+                if (!seg.hits_ground) continue;
+                ++hits;
+                const Vec3d g = k.camera + dir * seg.t_end;
+                const Vec3d n = Normalize(g);
+                const Vec3d tau_view = OpticalDepth(atm, k.camera + dir * seg.t_start, dir,
+                                                    seg.t_end - seg.t_start, 2000);
+                const Vec3d tau_sun =
+                    OpticalDepthToTopAtmosphereBoundary(atm, R, Dot(n, sun), 2000);
+                for (int c = 0; c < 3; ++c) {
+                    const double expected = atm.ground_albedo[c] * Dot(n, sun) / kPi *
+                                            std::exp(-tau_sun[c] - tau_view[c]);
+                    EXPECT_NEAR(r.ground[c], expected, 0.03 * expected)
+                        << "camera z " << k.camera.z << " pixel " << x << "," << y;
+                }
+            }
+        }
+        EXPECT_GE(hits, 8);
+    }
+}
+
 TEST(Hillaire, NoSeamAtTheTopOfTheAtmosphere) {
     // Just inside the top the sky-view table answers; just outside, the ray
     // march (40 steps). Both must agree where they meet.
