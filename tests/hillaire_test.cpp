@@ -75,6 +75,45 @@ double TransmittanceError(const HillaireModel& model, bool centres) {
     return worst;
 }
 
+TEST(Hillaire, TableMappingsInvertEachOther) {
+    const AtmosphereParameters atm = EarthAtmosphere();
+    // Transmittance: unit (x_mu, x_r) -> (r, mu) -> texture uv on the texel centres.
+    for (int j = 0; j < kHillaireTransmittanceHeight; j += 7) {
+        for (int i = 0; i < kHillaireTransmittanceWidth; i += 15) {
+            double r, mu, u, v;
+            HillaireTransmittanceRMu(atm, i / 255.0, j / 63.0, &r, &mu);
+            HillaireTransmittanceUv(atm, r, mu, &u, &v);
+            EXPECT_NEAR(u, (i + 0.5) / kHillaireTransmittanceWidth, 1e-6);
+            EXPECT_NEAR(v, (j + 0.5) / kHillaireTransmittanceHeight, 1e-9);
+        }
+    }
+    // Sky-view: the horizon sits at v = 0.5 and texels crowd around it.
+    for (double h : {0.0, 5000.0, 60e3}) {
+        const double r = atm.bottom_radius + h;
+        for (int j = 0; j < kHillaireSkyViewHeight; j += 5) {
+            for (int i = 0; i < kHillaireSkyViewWidth; i += 11) {
+                double mu_v, cos_az, u, v;
+                HillaireSkyViewParams(r, atm.bottom_radius, i / 191.0, j / 107.0, &mu_v, &cos_az);
+                HillaireSkyViewUv(r, atm.bottom_radius, mu_v, cos_az, &u, &v);
+                EXPECT_NEAR(u, (i + 0.5) / kHillaireSkyViewWidth, 1e-6);
+                EXPECT_NEAR(v, (j + 0.5) / kHillaireSkyViewHeight, 1e-6);
+            }
+        }
+        double beta, theta_h;
+        HillaireSkyViewHorizon(r, atm.bottom_radius, &beta, &theta_h);
+        double u, v;
+        HillaireSkyViewUv(r, atm.bottom_radius, std::cos(theta_h), 1.0, &u, &v);
+        EXPECT_NEAR(v, 0.5, 1e-9);
+        // Angular size of the texel rows next to the horizon vs at the zenith.
+        double mu_a, mu_b, mu_z0, mu_z1, c;
+        HillaireSkyViewParams(r, atm.bottom_radius, 0.0, 53.0 / 107.0, &mu_a, &c);
+        HillaireSkyViewParams(r, atm.bottom_radius, 0.0, 52.0 / 107.0, &mu_b, &c);
+        HillaireSkyViewParams(r, atm.bottom_radius, 0.0, 0.0, &mu_z0, &c);
+        HillaireSkyViewParams(r, atm.bottom_radius, 0.0, 1.0 / 107.0, &mu_z1, &c);
+        EXPECT_LT(std::acos(mu_a) - std::acos(mu_b), 0.2 * (std::acos(mu_z1) - std::acos(mu_z0)));
+    }
+}
+
 TEST(Hillaire, TransmittanceTableMatchesDirectIntegration) {
     // With 500 steps the table's texel centres hold the direct integral (this
     // checks the mapping and its inverse); between texels bilinear filtering
