@@ -229,6 +229,10 @@ void HillaireModel::BuildSkyView(double r, double mu_s, Table* table) const {
     const HillaireEvaluator& e = evaluator_;
     const AtmosphereParameters& atm = e.atm;
     table->Resize(kHillaireSkyViewWidth, kHillaireSkyViewHeight, 1, 3);
+    // The table's rays start at least kHillaireSkyViewMinAltitude above the
+    // ground, where its horizon angle is taken (else the texel row just above
+    // the horizon would start on the ground and read black).
+    r = Max(r, atm.bottom_radius + kHillaireSkyViewMinAltitude);
     const Vec3d camera(0.0, 0.0, r);
     const Vec3d sun(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
     const int n = sky_view_steps_;

@@ -70,8 +70,8 @@
 // from the path tracer (seed 003 section 12.1.1).
 //
 // Deviations from the paper's demo: geometry in double, tables in float; the
-// sky-view table clamps the camera altitude to >= 1 m for its horizon angle
-// (the demo offsets the camera by 10 m); the aerial-perspective volume is built
+// sky-view table is built for a camera at least 1 m above the ground (the
+// demo offsets the camera by 10 m); the aerial-perspective volume is built
 // by one cumulative march per screen column (`--ap-steps-per-slice` segments
 // per slice, 4) instead of one march per froxel, lets the froxel rays pass
 // through the ground (above), blends to the sky-view path near its far end,
