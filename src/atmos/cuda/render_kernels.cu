@@ -6,6 +6,7 @@
 
 #include "models/empty.h"
 #include "models/flat.h"
+#include "models/hillaire.h"
 #include "models/naive.h"
 #include "models/reference.h"
 #include "models/oneil.h"
@@ -49,6 +50,8 @@ template cudaError_t LaunchRender<ReferenceEvaluator>(const ReferenceEvaluator&,
                                                       float*, cudaStream_t);
 template cudaError_t LaunchRender<NaiveEvaluator>(const NaiveEvaluator&, const PixelSetup&, float*,
                                                   cudaStream_t);
+template cudaError_t LaunchRender<HillaireEvaluator>(const HillaireEvaluator&, const PixelSetup&,
+                                                     float*, cudaStream_t);
 
 template cudaError_t LaunchRender<FlatEvaluator>(const FlatEvaluator&, const PixelSetup&, float*,
                                                  cudaStream_t);

@@ -8,6 +8,7 @@
 #include "atmos/model.h"
 #include "models/empty.h"
 #include "models/flat.h"
+#include "models/hillaire.h"
 #include "models/naive.h"
 #include "models/reference.h"
 #include "models/oneil.h"
@@ -52,6 +53,7 @@ const std::vector<Entry>& Registry() {
         MakeEntry<TransmittanceChapmanModel>(),
         MakeEntry<TransmittanceOneilModel>(),
         MakeEntry<TransmittancePolynomialModel>(),
+        MakeEntry<HillaireModel>(),
     };
     return entries;
 }

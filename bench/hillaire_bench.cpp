@@ -1,0 +1,146 @@
+// Benchmarks of the `hillaire` model: each table's build time and the
+// per-frame render time at 1920 x 1080, on two threads.
+//
+// Run: build/bench/atmos_bench --benchmark_filter=Hillaire
+//        --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+// Transmittance and multiple scattering depend only on the atmosphere
+// (Prepare); the sky-view table and the aerial-perspective volume depend on
+// the camera and the sun, so they are per-frame work (seed 003 section 11.6
+// counts the sky-view table as part of the render). A frame = BuildFrame +
+// the per-pixel loop; cameras outside the atmosphere (orbit, space) build no
+// frame tables and ray march every pixel.
+#include <benchmark/benchmark.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "atmos/atmosphere.h"
+#include "atmos/image.h"
+#include "atmos/view.h"
+#include "base/parallel.h"
+#include "models/hillaire.h"
+#include "render/render.h"
+
+namespace atmos {
+namespace {
+
+constexpr int kThreads = 2;
+constexpr int kWidth = 1920;
+constexpr int kHeight = 1080;
+
+std::unique_ptr<HillaireModel> PreparedModel() {
+    const ModelOptions options("hillaire", HillaireModel::StaticInfo().options, {});
+    auto model = std::make_unique<HillaireModel>(options);
+    model->Prepare(EarthAtmosphere());
+    return model;
+}
+
+void BM_HillaireTransmittanceTable(benchmark::State& state) {
+    ThreadLimit limit(kThreads);
+    auto model = PreparedModel();
+    for (auto _ : state) model->BuildTransmittance();
+}
+BENCHMARK(BM_HillaireTransmittanceTable)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_HillaireMultipleScatteringTable(benchmark::State& state) {
+    ThreadLimit limit(kThreads);
+    auto model = PreparedModel();
+    for (auto _ : state) model->BuildMultipleScattering();
+}
+BENCHMARK(BM_HillaireMultipleScatteringTable)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+const char* const kViews[] = {"ground-sunrise", "plane-noon", "orbit-sunrise", "space"};
+
+void BM_HillaireSkyViewTable(benchmark::State& state) {
+    ThreadLimit limit(kThreads);
+    auto model = PreparedModel();
+    const View view = GetView(kViews[state.range(0)], model->atmosphere());
+    state.SetLabel(view.name);
+    for (auto _ : state) {
+        auto frame = model->BuildFrame(view.camera, view.sun_direction,
+                                       static_cast<double>(kWidth) / kHeight, false);
+        benchmark::DoNotOptimize(frame);
+    }
+}
+BENCHMARK(BM_HillaireSkyViewTable)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Sky-view + aerial perspective (the whole per-frame table work).
+void BM_HillaireFrameTables(benchmark::State& state) {
+    ThreadLimit limit(kThreads);
+    auto model = PreparedModel();
+    const View view = GetView(kViews[state.range(0)], model->atmosphere());
+    state.SetLabel(view.name);
+    HillaireFrameTimings t;
+    for (auto _ : state) {
+        auto frame = model->BuildFrame(view.camera, view.sun_direction,
+                                       static_cast<double>(kWidth) / kHeight, true);
+        t = frame->timings;
+        benchmark::DoNotOptimize(frame);
+    }
+    state.counters["sky_view_ms"] = 1e3 * t.sky_view_s;
+    state.counters["aerial_perspective_ms"] = 1e3 * t.aerial_perspective_s;
+}
+BENCHMARK(BM_HillaireFrameTables)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The per-pixel loop alone at 1920 x 1080 (frame tables built outside the timing).
+void BM_HillaireRenderPixels(benchmark::State& state) {
+    ThreadLimit limit(kThreads);
+    auto model = PreparedModel();
+    const View view = GetView(kViews[state.range(0)], model->atmosphere());
+    state.SetLabel(view.name);
+    RenderRequest request;
+    request.view = view;
+    request.width = kWidth;
+    request.height = kHeight;
+    request.show_progress = false;
+    const PixelSetup setup = MakePixelSetup(request, model->atmosphere());
+    auto frame = model->BuildFrame(view.camera, view.sun_direction,
+                                   static_cast<double>(kWidth) / kHeight, true);
+    const HillaireEvaluator evaluator = frame->Evaluator();
+    Image image(kWidth, kHeight);
+    for (auto _ : state) RenderImage(evaluator, setup, image.View(), false);
+}
+BENCHMARK(BM_HillaireRenderPixels)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// A whole frame: Model::Render (frame tables + pixels) at 1920 x 1080.
+void BM_HillaireRenderFrame(benchmark::State& state) {
+    ThreadLimit limit(kThreads);
+    auto model = PreparedModel();
+    const View view = GetView(kViews[state.range(0)], model->atmosphere());
+    state.SetLabel(view.name);
+    RenderRequest request;
+    request.view = view;
+    request.width = kWidth;
+    request.height = kHeight;
+    request.show_progress = false;
+    Image image;
+    for (auto _ : state) model->Render(request, &image);
+}
+BENCHMARK(BM_HillaireRenderFrame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Nanoseconds per Evaluate() (one view ray) on one thread, over a fixed set of
+// the view's pixel directions: the table path (ground-sunrise) and the ray
+// march (space).
+void BM_HillaireEvaluate(benchmark::State& state) {
+    auto model = PreparedModel();
+    const View view = GetView(kViews[state.range(0)], model->atmosphere());
+    state.SetLabel(view.name);
+    auto frame = model->BuildFrame(view.camera, view.sun_direction, 16.0 / 9.0, true);
+    const HillaireEvaluator e = frame->Evaluator();
+    std::vector<Vec3d> dirs;
+    for (int i = 0; i < 64 * 36; ++i) {
+        dirs.push_back(view.camera.RayDirection(i % 64, i / 64, 64, 36));
+    }
+    size_t i = 0;
+    for (auto _ : state) {
+        RayResult r = e.Evaluate(view.camera.position, dirs[i], view.sun_direction, true);
+        benchmark::DoNotOptimize(r);
+        i = (i + 1) % dirs.size();
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_HillaireEvaluate)->Arg(0)->Arg(3);
+
+}  // namespace
+}  // namespace atmos
