@@ -104,11 +104,14 @@ void FilterRows(const Plane& in, const std::vector<float>& kernel, Plane* out) {
         const float* src = in.Row(y);
         for (int i = 0; i < in.w + 2 * r; ++i)
             padded[i] = src[std::min(std::max(i - r, 0), in.w - 1)];
+        // Accumulate tap by tap (the same summation order per pixel as a
+        // per-pixel loop over k, but vectorizable over x without fast-math).
         float* dst = out->Row(y);
-        for (int x = 0; x < in.w; ++x) {
-            float s = 0.0f;
-            for (int k = 0; k <= 2 * r; ++k) s += kernel[k] * padded[x + k];
-            dst[x] = s;
+        std::fill(dst, dst + in.w, 0.0f);
+        for (int k = 0; k <= 2 * r; ++k) {
+            const float wk = kernel[k];
+            const float* src_k = padded.data() + k;
+            for (int x = 0; x < in.w; ++x) dst[x] += wk * src_k[x];
         }
     });
 }
