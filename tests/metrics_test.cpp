@@ -256,6 +256,10 @@ TEST(Flip, HdrWithBlackPixelsIsFiniteAndCorrect) {
 TEST(Flip, RejectsMismatchedSizes) {
     EXPECT_THROW(HdrFlip(Image(4, 4), Image(4, 5)), Error);
     EXPECT_THROW(LdrFlip(Image(), Image()), Error);
+    Image nan_image(4, 4);
+    nan_image.Set(1, 1, Rgb(std::nanf(""), 0.0f, 0.0f));
+    EXPECT_THROW(HdrFlip(Image(4, 4), nan_image), Error);
+    EXPECT_THROW(ComputeRmse(nan_image, Image(4, 4)), Error);
 }
 
 TEST(Rmse, HandComputedCase) {

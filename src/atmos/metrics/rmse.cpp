@@ -15,6 +15,14 @@ void CheckPair(const Image& a, const Image& b) {
         Fail("RMSE needs images of the same size (reference ", a.width(), "x", a.height(),
              ", test ", b.width(), "x", b.height(), ")");
     }
+    for (const Image* img : {&a, &b}) {
+        for (size_t i = 0; i < img->size(); ++i) {
+            if (!std::isfinite(img->data()[i])) {
+                Fail("RMSE: the ", img == &a ? "reference" : "test",
+                     " image holds a NaN or infinite value");
+            }
+        }
+    }
 }
 }  // namespace
 
