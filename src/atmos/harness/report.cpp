@@ -56,7 +56,9 @@ std::string General(double v, int digits) {
 void MetricTable(std::ostream& f, const std::string& title, int digits, const CompareResult& r,
                  bool flip) {
     f << "<table class=\"metric\"><caption>" << Escape(title) << "</caption>\n<tr><th>view</th>";
-    for (const std::string& m : r.models) f << "<th>" << Escape(m) << "</th>";
+    for (size_t m = 0; m < r.models.size(); ++m) {
+        f << "<th title=\"" << Escape(r.model_titles[m]) << "\">" << Escape(r.models[m]) << "</th>";
+    }
     f << "</tr>\n";
     for (const CompareRow& row : r.rows) {
         std::vector<double> values;
@@ -108,7 +110,7 @@ void TimeChart(std::ostream& f, const CompareConfig& config, const CompareResult
     for (const Bar& b : bars) max_ms = std::max(max_ms, b.mean_ms);
     const int label_w = 220, bar_w = 520, row_h = 26;
     const int height = row_h * static_cast<int>(bars.size()) + 30;
-    f << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << label_w + bar_w + 260
+    f << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << label_w + bar_w + 480
       << "\" height=\"" << height << "\" role=\"img\" aria-label=\"render times\">\n";
     for (size_t i = 0; i < bars.size(); ++i) {
         const Bar& b = bars[i];
@@ -121,7 +123,7 @@ void TimeChart(std::ostream& f, const CompareConfig& config, const CompareResult
           << "\" height=\"" << row_h - 8 << "\" fill=\"" << (i == 0 ? "#c96" : "#59c") << "\"/>";
         std::string text = Fixed(b.mean_ms, 1) + " ms";
         if (b.prepare_ms > 0.0) text += " + prepare " + Fixed(b.prepare_ms, 1) + " ms";
-        if (b.cached) text += " (cached: time of the original render)";
+        if (b.cached) text += " (cached: the time of the original render)";
         f << "<text x=\"" << label_w + w + 6 << "\" y=\"" << y + 15
           << "\" fill=\"#bbb\" font-size=\"12\">" << Escape(text) << "</text>\n";
     }
