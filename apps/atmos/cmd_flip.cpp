@@ -32,10 +32,7 @@ int CmdFlip(const FlipCliOptions& o) {
     options.has_stop_exposure = o.stop_flag->count() > 0;
     options.stop_exposure = o.stop;
     options.num_exposures = o.exposures;
-    if (!o.output.empty() && ImageFormatFromPath(o.output) != ImageFormat::kPng &&
-        ImageFormatFromPath(o.output) != ImageFormat::kExr) {
-        Fail("the FLIP map is written as .png (colour-mapped) or .exr (values)");
-    }
+    if (!o.output.empty()) ImageFormatFromPath(o.output);  // fail early on a bad extension
     bool hdr = false;
     if (o.mode == "auto") {
         hdr = ImageFormatFromPath(o.reference) != ImageFormat::kPng;
@@ -77,7 +74,8 @@ Command AddFlipCommand(CLI::App* root) {
         "flip", "FLIP difference of two images (HDR-FLIP unless the reference is a PNG)");
     cmd->add_option("reference", o->reference, "reference image (.exr .npy .pfm .png)")->required();
     cmd->add_option("test", o->test, "test image")->required();
-    cmd->add_option("-o,--output", o->output, "error map: .png (magma colour map) or .exr");
+    cmd->add_option("-o,--output", o->output,
+                    "error map: .png (magma colour map), or .exr .npy .pfm (values)");
     cmd->add_option("--ppd", o->ppd, "pixels per degree (default 67.0206: 0.7 m, 0.7 m, 3840 px)");
     cmd->add_option("--tonemapper", o->tone_mapper, "HDR tone mapper: aces, hable, reinhard")
         ->capture_default_str();
