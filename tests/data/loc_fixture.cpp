@@ -13,14 +13,14 @@ struct Sky {  // counts
     float radiance = 0.0f;  // counts
 };
 
-float Scatter(float mu) {  // counts
+float Scatter(float mu) {             // counts
     const char* url = "http://a//b";  // counts: "//" inside a string is not a comment
     float phase = 3.0f / (16.0f * 3.14159f) * (1.0f + mu * mu);  // counts
-    return phase /* inline block */ * 2.0f;  // counts
+    return phase /* inline block */ * 2.0f;                      // counts
 }
 
 }  // namespace demo
 
-int main() {  // counts
+int main() {                                       // counts
     return static_cast<int>(demo::Scatter(0.5f));  // counts
 }
