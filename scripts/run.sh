@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# The main job: set up, build, and render the 12 views with the default model
-# into out/ (PNG + EXR per view) with out/index.html showing them.
-# Usage: scripts/run.sh [MODEL] [WIDTHxHEIGHT]
+# The main job: set up, build, and compare every model against the reference at
+# the 12 views: out/index.html (the report), out/flip.csv, out/rmse.csv,
+# out/images/, out/errors/. Renders are cached in out/cache, so a second run
+# only recomputes what changed. Extra arguments go to `atmos compare`, e.g.
+#   scripts/run.sh --size 1920x1080 --reference-spp 1024     # a full run
 set -euo pipefail
 cd "$(dirname "$0")/.."
-model="${1:-naive}"
-size="${2:-960x540}"
 scripts/setup.sh
-build/atmos render --model "$model" --view all --size "$size" -o out
+build/atmos compare "$@"
 echo "open out/index.html"

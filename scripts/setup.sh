@@ -16,8 +16,10 @@ if [ -z "$build_dir" ]; then
     if [ "$sanitize" = ON ]; then build_dir=build-asan; else build_dir=build; fi
 fi
 
+# chromium + a font: the report test loads out/index.html in headless Chromium.
 packages=(cmake g++ make ninja-build pkg-config libopenexr-dev libpng-dev nlohmann-json3-dev
-          libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev clang-format)
+          libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev clang-format
+          chromium fonts-dejavu-core)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

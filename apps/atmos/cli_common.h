@@ -53,5 +53,11 @@ Command AddListCommand(CLI::App* root);
 Command AddRenderCommand(CLI::App* root);
 Command AddSampleCommand(CLI::App* root);
 Command AddBakeCommand(CLI::App* root);
+Command AddFlipCommand(CLI::App* root);
+Command AddRmseCommand(CLI::App* root);
+// compare records its command line (argc, argv) for the report.
+Command AddCompareCommand(CLI::App* root, int argc, char** argv);
+Command AddBenchCommand(CLI::App* root);
+Command AddLocCommand(CLI::App* root);
 
 }  // namespace atmos::cli

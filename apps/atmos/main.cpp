@@ -23,6 +23,11 @@ int main(int argc, char** argv) {
         AddRenderCommand(&app),
         AddSampleCommand(&app),
         AddBakeCommand(&app),
+        AddFlipCommand(&app),
+        AddRmseCommand(&app),
+        AddCompareCommand(&app, argc, argv),
+        AddBenchCommand(&app),
+        AddLocCommand(&app),
     };
     try {
         if (argc > 1 && argv[1][0] != '-') {

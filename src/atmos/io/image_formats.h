@@ -24,6 +24,9 @@ Image ReadExr(const std::string& path);
 // decodes the sRGB curve to linear [0, 1].
 void WritePng(const Image& image, const std::string& path, float exposure);
 Image ReadPng(const std::string& path);
+// 8-bit sRGB-encoded RGB bytes (width * height * 3, top row first) as a PNG, untouched.
+void WritePngBytes(const std::vector<std::uint8_t>& bytes, int width, int height,
+                   const std::string& path);
 
 // NumPy .npy: writes '<f4' of shape (H, W, 3), C order. Reads '<f4' or '<f8',
 // C order, shape (H, W, 3), (H, W, 4) (alpha dropped), (H, W, 1) or (H, W)

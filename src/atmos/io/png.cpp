@@ -130,12 +130,17 @@ bool DecodePng(std::FILE* file, PngPixels* out, PngErrorState* error) {
 }  // namespace
 
 void WritePng(const Image& image, const std::string& path, float exposure) {
-    const int width = image.width();
-    const int height = image.height();
     std::vector<std::uint8_t> bytes(image.size());
     const float* src = image.data();
     for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = EncodeDisplayValue(src[i], exposure);
+    WritePngBytes(bytes, image.width(), image.height(), path);
+}
 
+void WritePngBytes(const std::vector<std::uint8_t>& bytes, int width, int height,
+                   const std::string& path) {
+    if (bytes.size() != static_cast<size_t>(width) * height * 3) {
+        Fail("cannot write PNG '", path, "': wrong number of bytes");
+    }
     png_image png;
     std::memset(&png, 0, sizeof(png));
     png.version = PNG_IMAGE_VERSION;

@@ -1,0 +1,168 @@
+// atmos CLI: `atmos compare`: every model against the reference at the 12 views
+// (src/atmos/harness/compare.h), tables + images + index.html.
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "atmos/atmosphere.h"
+#include "atmos/error.h"
+#include "atmos/model.h"
+#include "base/parallel.h"
+#include "cli_common.h"
+#include "harness/compare.h"
+
+namespace atmos::cli {
+
+namespace {
+
+// The reference model when none is given and `reference` is not registered.
+constexpr const char* kStandInReference = "naive";
+constexpr int kDefaultReferenceSpp = 64;
+
+struct CompareCliOptions {
+    std::vector<std::string> models, views, sets, reference_options;
+    std::string size = "320x180";
+    std::string quantity = "radiance";
+    std::string reference;
+    int reference_spp = kDefaultReferenceSpp;
+    CLI::Option* spp_flag = nullptr;
+    std::string atmosphere = "earth";
+    std::string output;
+    std::string cache = "out/cache";
+    bool no_cache = false;
+    bool no_npy = false;
+    bool quiet = false;
+    int threads = 0;
+    double ppd = 0.0;
+    std::string tone_mapper = "aces";
+    std::string command_line;
+};
+
+bool IsRegistered(const std::string& name) {
+    for (const ModelInfo& info : ListModels()) {
+        if (info.name == name) return true;
+    }
+    return false;
+}
+
+bool HasOption(const std::string& model, const std::string& option) {
+    for (const ModelOptionSpec& s : GetModelInfo(model).options) {
+        if (s.name == option) return true;
+    }
+    return false;
+}
+
+int CmdCompare(const CompareCliOptions& o) {
+    CompareConfig config;
+    ParseSize(o.size, &config.width, &config.height);
+    config.quantity = ParseQuantity(o.quantity);
+    config.models = o.models;
+    config.views = o.views;
+    for (const std::string& v : o.views) GetView(v, AtmosphereParameters{});  // fail early
+    for (const std::string& m : o.models) GetModelInfo(m);
+    config.atmosphere_name = o.atmosphere;
+    config.atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
+    config.output_dir = !o.output.empty()                             ? o.output
+                        : config.quantity == Quantity::kTransmittance ? "out/transmittance"
+                                                                      : "out";
+    config.cache_dir = o.no_cache ? "" : o.cache;
+    config.write_npy = !o.no_npy;
+    config.show_progress = !o.quiet;
+    config.flip.ppd = o.ppd;
+    config.flip.tone_mapper = ParseFlipToneMapper(o.tone_mapper);
+    config.command_line = o.command_line;
+
+    // The reference: `reference` (the path tracer) when registered, else a stand-in.
+    const bool spp_given = o.spp_flag->count() > 0;
+    if (!o.reference.empty()) {
+        config.reference_model = GetModelInfo(o.reference).name;
+        config.reference_note = "chosen with --reference";
+    } else if (IsRegistered("reference")) {
+        config.reference_model = "reference";
+        config.reference_note = "the path tracer";
+    } else {
+        config.reference_model = kStandInReference;
+        config.reference_options = {{"steps", "256"}, {"light-steps", "64"}};
+        config.reference_note =
+            "stand-in: the path tracer `reference` is not registered in this build";
+    }
+    for (const std::string& kv : o.reference_options) {
+        const size_t eq = kv.find('=');
+        if (eq == std::string::npos || eq == 0) {
+            Fail("--reference-option expects NAME=VALUE, got '", kv, "'");
+        }
+        config.reference_options[kv.substr(0, eq)] = kv.substr(eq + 1);
+    }
+    if (HasOption(config.reference_model, "spp")) {
+        if (config.reference_options.count("spp") == 0) {
+            config.reference_options["spp"] = std::to_string(o.reference_spp);
+        }
+    } else if (spp_given) {
+        Fail("--reference-spp needs a reference model with an `spp` option (",
+             config.reference_model, " has none)");
+    }
+    CreateModel(config.reference_model, config.reference_options);  // validate the options
+
+    ThreadLimit limit(o.threads);
+    const CompareResult r = RunCompare(config);
+    if (!o.quiet) {
+        std::fprintf(stderr, "compared %zu models at %zu views in %.1f s (%d threads)\n",
+                     r.models.size(), r.rows.size(), r.total_seconds, r.threads);
+    }
+    std::printf("reference: %s\n", config.reference_model.c_str());
+    std::printf("wrote %s/flip.csv, %s/rmse.csv, %s/index.html\n", config.output_dir.c_str(),
+                config.output_dir.c_str(), config.output_dir.c_str());
+    return 0;
+}
+
+}  // namespace
+
+Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
+    auto o = std::make_shared<CompareCliOptions>();
+    std::ostringstream cl;
+    for (int i = 0; i < argc; ++i) cl << (i ? " " : "") << argv[i];
+    o->command_line = cl.str();
+    CLI::App* cmd = root->add_subcommand(
+        "compare", "every model against the reference: FLIP, RMSE, images, index.html");
+    cmd->add_option("--models", o->models, "models (default: all but the reference)")
+        ->delimiter(',');
+    cmd->add_option("--views", o->views, "views (default: all 12; transmittance: 5)")
+        ->delimiter(',');
+    cmd->add_option("--size,-s", o->size, "image size WIDTHxHEIGHT")->capture_default_str();
+    cmd->add_option("--quantity", o->quantity, "radiance (HDR-FLIP) or transmittance (LDR-FLIP)")
+        ->capture_default_str();
+    o->spp_flag = cmd->add_option("--reference-spp", o->reference_spp,
+                                  "samples per pixel of the path-traced reference")
+                      ->capture_default_str()
+                      ->check(CLI::PositiveNumber);
+    cmd->add_option("--reference", o->reference,
+                    "reference model (default: `reference` when registered, else naive with "
+                    "--steps 256 --light-steps 64)");
+    cmd->add_option("--reference-option", o->reference_options,
+                    "a model option of the reference, NAME=VALUE (repeatable)")
+        ->allow_extra_args(false);
+    cmd->add_option("--atmosphere,-a", o->atmosphere, "preset name or JSON file")
+        ->capture_default_str();
+    cmd->add_option("--set", o->sets, "override one atmosphere field: FIELD=VALUE (repeatable)")
+        ->allow_extra_args(false);
+    cmd->add_option("-o,--output", o->output,
+                    "output directory (default out, or out/transmittance)");
+    cmd->add_option("--cache", o->cache, "render cache directory")->capture_default_str();
+    cmd->add_flag("--no-cache", o->no_cache, "render everything, read and write no cache");
+    cmd->add_flag("--no-npy", o->no_npy, "do not write .npy images");
+    cmd->add_option("--ppd", o->ppd, "FLIP pixels per degree (default 67.0206)");
+    cmd->add_option("--tonemapper", o->tone_mapper, "HDR-FLIP tone mapper: aces, hable, reinhard")
+        ->capture_default_str();
+    cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_flag("--quiet,-q", o->quiet, "no progress lines");
+    Command c;
+    c.app = cmd;
+    c.run = [o] { return CmdCompare(*o); };
+    return c;
+}
+
+}  // namespace atmos::cli

@@ -1,0 +1,306 @@
+// atmos: the comparison harness (see compare.h).
+#include "harness/compare.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include "atmos/error.h"
+#include "base/parallel.h"
+#include "harness/render_cache.h"
+#include "harness/report.h"
+#include "metrics/rmse.h"
+
+namespace fs = std::filesystem;
+
+namespace atmos {
+
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// A model's images, rendered on demand: Prepare() runs once, only if some
+// image is not in the cache.
+class LazyRenderer {
+  public:
+    LazyRenderer(std::string name, std::map<std::string, std::string> options,
+                 const CompareConfig& config, const RenderCache& cache)
+        : name_(std::move(name)), options_(std::move(options)), config_(config), cache_(cache) {
+        key_.model = name_;
+        key_.options = ResolvedModelOptions(name_, options_);
+        key_.atmosphere_json = AtmosphereToJson(config.atmosphere);
+        key_.width = config.width;
+        key_.height = config.height;
+        key_.quantity = config.quantity;
+    }
+
+    Image Render(const View& view, double* seconds, bool* cached) {
+        RenderKey key = key_;
+        key.view = view.name;
+        Image image;
+        if (cache_.Load(key, &image, seconds)) {
+            *cached = true;
+            return image;
+        }
+        if (!model_) {
+            model_ = CreateModel(name_, options_);
+            const auto start = std::chrono::steady_clock::now();
+            model_->Prepare(config_.atmosphere);
+            prepare_seconds_ = SecondsSince(start);
+            prepared_ = true;
+        }
+        RenderRequest request;
+        request.view = view;
+        request.width = config_.width;
+        request.height = config_.height;
+        request.quantity = config_.quantity;
+        request.show_progress = config_.show_progress;
+        const auto start = std::chrono::steady_clock::now();
+        model_->Render(request, &image);
+        *seconds = SecondsSince(start);
+        *cached = false;
+        cache_.Store(key, image, *seconds);
+        return image;
+    }
+
+    double prepare_seconds() const { return prepare_seconds_; }
+    bool prepared() const { return prepared_; }
+
+  private:
+    std::string name_;
+    std::map<std::string, std::string> options_;
+    const CompareConfig& config_;
+    const RenderCache& cache_;
+    RenderKey key_;
+    std::unique_ptr<Model> model_;
+    double prepare_seconds_ = 0.0;
+    bool prepared_ = false;
+};
+
+std::string FileStem(const std::string& name) {
+    std::string s;
+    for (char c : name) {
+        const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
+                        (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
+        s += ok ? c : '_';
+    }
+    return s;
+}
+
+void WriteImages(const Image& image, const fs::path& dir, const std::string& stem, float exposure,
+                 bool npy) {
+    WriteImage(image, (dir / (stem + ".png")).string(), exposure);
+    WriteImage(image, (dir / (stem + ".exr")).string());
+    if (npy) WriteImage(image, (dir / (stem + ".npy")).string());
+}
+
+}  // namespace
+
+std::vector<std::string> DefaultCompareViews(Quantity quantity) {
+    if (quantity == Quantity::kTransmittance) {
+        return {"ground-noon", "plane-noon", "orbit-noon", "space", "planet-shadow-orbit"};
+    }
+    return StandardViewNames();
+}
+
+std::string CompareRowLabel(const std::string& view, Quantity quantity) {
+    if (quantity == Quantity::kTransmittance) {
+        for (const char* place : {"ground", "plane", "orbit"}) {
+            const std::string p = place;
+            if (view == p + "-noon" || view == p + "-sunrise" || view == p + "-dawn") return p;
+        }
+    }
+    return view;
+}
+
+std::string ValidityNote(const ModelCapabilities& caps, const View& view,
+                         const AtmosphereParameters& atmosphere) {
+    std::string note;
+    const double r = Length(view.camera.position);
+    const double altitude = r - atmosphere.bottom_radius;
+    if (!caps.space_views && altitude > 1.0) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "declared valid on the ground only (camera at %.0f km)",
+                      altitude / 1000.0);
+        note = buf;
+    }
+    const Vec3d up = view.camera.position / r;
+    if (!caps.sun_below_horizon && Dot(view.sun_direction, up) < 0.0) {
+        if (!note.empty()) note += "; ";
+        note += "declared valid with the sun above the horizon only";
+    }
+    return note;
+}
+
+int BestIndex(const std::vector<double>& row) {
+    int best = -1;
+    for (size_t i = 0; i < row.size(); ++i) {
+        if (!std::isfinite(row[i])) continue;
+        if (best < 0 || row[i] < row[static_cast<size_t>(best)]) best = static_cast<int>(i);
+    }
+    return best;
+}
+
+void WriteMetricCsv(const std::string& path, const std::string& corner,
+                    const std::vector<std::string>& row_labels,
+                    const std::vector<std::string>& columns,
+                    const std::vector<std::vector<double>>& values) {
+    std::ofstream f(path);
+    if (!f) Fail("cannot write '", path, "'");
+    f << corner;
+    for (const std::string& c : columns) f << "," << c;
+    f << ",best\n";
+    for (size_t r = 0; r < row_labels.size(); ++r) {
+        f << row_labels[r];
+        for (double v : values[r]) {
+            char buf[32];
+            std::snprintf(buf, sizeof buf, "%.8g", v);
+            f << "," << (std::isfinite(v) ? buf : "");
+        }
+        const int best = BestIndex(values[r]);
+        f << "," << (best >= 0 ? columns[static_cast<size_t>(best)] : "") << "\n";
+    }
+    if (!f) Fail("cannot write '", path, "'");
+}
+
+CompareResult RunCompare(const CompareConfig& config) {
+    const auto start = std::chrono::steady_clock::now();
+    CompareResult result;
+    result.threads = ParallelThreadCount();
+    const bool transmittance = config.quantity == Quantity::kTransmittance;
+
+    // Models: those given, or every registered one producing the quantity.
+    if (config.models.empty()) {
+        for (const ModelInfo& info : ListModels()) {
+            if (info.name == "reference") continue;
+            if (transmittance ? !info.capabilities.transmittance : !info.capabilities.radiance) {
+                continue;
+            }
+            result.models.push_back(info.name);
+        }
+    } else {
+        for (const std::string& m : config.models) {
+            const ModelInfo& info = GetModelInfo(m);
+            if (transmittance ? !info.capabilities.transmittance : !info.capabilities.radiance) {
+                Fail("model '", m, "' does not produce ", QuantityName(config.quantity));
+            }
+            result.models.push_back(info.name);
+        }
+    }
+    if (result.models.empty()) Fail("compare: no model to compare");
+    for (const std::string& m : result.models) result.model_titles.push_back(GetModelInfo(m).title);
+    const std::vector<std::string> view_names =
+        config.views.empty() ? DefaultCompareViews(config.quantity) : config.views;
+    std::vector<View> views;
+    for (const std::string& v : view_names) views.push_back(GetView(v, config.atmosphere));
+
+    const fs::path out(config.output_dir);
+    fs::create_directories(out);
+    const RenderCache cache(config.cache_dir);
+    LazyRenderer reference(config.reference_model, config.reference_options, config, cache);
+    std::vector<std::unique_ptr<LazyRenderer>> renderers;
+    for (const std::string& m : result.models) {
+        renderers.push_back(
+            std::make_unique<LazyRenderer>(m, std::map<std::string, std::string>{}, config, cache));
+    }
+
+    for (const View& view : views) {
+        CompareRow row;
+        row.view = view.name;
+        row.label = CompareRowLabel(view.name, config.quantity);
+        row.description = view.description;
+        const float exposure = transmittance ? 1.0f : view.exposure;
+        const fs::path image_dir = out / "images" / FileStem(view.name);
+        const fs::path error_dir = out / "errors" / FileStem(view.name);
+        fs::create_directories(image_dir);
+        fs::create_directories(error_dir);
+        const Image ref = reference.Render(view, &row.reference_seconds, &row.reference_cached);
+        WriteImages(ref, image_dir, "reference", exposure, config.write_npy);
+        row.reference_png = (fs::path("images") / FileStem(view.name) / "reference.png").string();
+        if (config.show_progress) {
+            std::fprintf(stderr, "%-22s reference (%s) %s %.3f s\n", view.name.c_str(),
+                         config.reference_model.c_str(),
+                         row.reference_cached ? "cached" : "rendered", row.reference_seconds);
+        }
+        for (size_t m = 0; m < result.models.size(); ++m) {
+            const std::string& name = result.models[m];
+            const std::string stem = FileStem(name);
+            CompareCell cell;
+            const Image img = renderers[m]->Render(view, &cell.render_seconds, &cell.cached);
+            WriteImages(img, image_dir, stem, exposure, config.write_npy);
+            const FlipResult flip =
+                transmittance ? LdrFlip(ref, img, config.flip) : HdrFlip(ref, img, config.flip);
+            const RmseResult rmse = ComputeRmse(ref, img);
+            cell.flip = flip.mean;
+            cell.rmse = rmse.overall;
+            WriteColorMappedPng(flip.map, flip.width, flip.height,
+                                (error_dir / (stem + "-flip.png")).string());
+            const Image abs_error = AbsoluteErrorImage(ref, img);
+            WriteImage(abs_error, (error_dir / (stem + "-rmse.exr")).string());
+            WriteImage(abs_error, (error_dir / (stem + "-rmse.png")).string(), exposure);
+            cell.validity_note =
+                ValidityNote(GetModelInfo(name).capabilities, view, config.atmosphere);
+            cell.image_png = (fs::path("images") / FileStem(view.name) / (stem + ".png")).string();
+            cell.flip_png =
+                (fs::path("errors") / FileStem(view.name) / (stem + "-flip.png")).string();
+            cell.rmse_png =
+                (fs::path("errors") / FileStem(view.name) / (stem + "-rmse.png")).string();
+            if (config.show_progress) {
+                std::fprintf(stderr, "%-22s %-20s %s %.3f s  FLIP %.6f  RMSE %.8f%s\n",
+                             view.name.c_str(), name.c_str(), cell.cached ? "cached" : "rendered",
+                             cell.render_seconds, cell.flip, cell.rmse,
+                             cell.validity_note.empty() ? "" : "  (outside validity)");
+            }
+            row.cells.push_back(cell);
+        }
+        result.rows.push_back(row);
+    }
+    for (const auto& r : renderers) {
+        result.prepare_seconds.push_back(r->prepare_seconds());
+        result.prepared.push_back(r->prepared());
+    }
+    result.reference_prepare_seconds = reference.prepare_seconds();
+    const std::string source_dir = DefaultSourceDir();
+    for (const std::string& m : result.models) result.loc.push_back(CountModelLoc(source_dir, m));
+    result.loc.push_back(CountModelLoc(source_dir, config.reference_model));
+
+    // Tables (thesis Appendix A/B, or C/D for transmittance) and times.
+    std::vector<std::string> labels;
+    std::vector<std::vector<double>> flips, rmses;
+    for (const CompareRow& row : result.rows) {
+        labels.push_back(row.label);
+        std::vector<double> f, r;
+        for (const CompareCell& c : row.cells) {
+            f.push_back(c.flip);
+            r.push_back(c.rmse);
+        }
+        flips.push_back(f);
+        rmses.push_back(r);
+    }
+    WriteMetricCsv((out / "flip.csv").string(), "FLIP errors", labels, result.models, flips);
+    WriteMetricCsv((out / "rmse.csv").string(), "RMSE errors", labels, result.models, rmses);
+    {
+        std::ofstream f(out / "times.csv");
+        f << "view,model,render_seconds,cached,prepare_seconds\n";
+        for (const CompareRow& row : result.rows) {
+            f << row.view << ",reference:" << config.reference_model << "," << row.reference_seconds
+              << "," << (row.reference_cached ? 1 : 0) << "," << result.reference_prepare_seconds
+              << "\n";
+            for (size_t m = 0; m < result.models.size(); ++m) {
+                f << row.view << "," << result.models[m] << "," << row.cells[m].render_seconds
+                  << "," << (row.cells[m].cached ? 1 : 0) << "," << result.prepare_seconds[m]
+                  << "\n";
+            }
+        }
+    }
+    result.total_seconds = SecondsSince(start);
+    WriteCompareReport((out / "index.html").string(), config, result);
+    return result;
+}
+
+}  // namespace atmos

@@ -1,0 +1,101 @@
+// atmos: the comparison harness behind `atmos compare` (DESIGN.md; seed 003
+// sections 11.5-11.7 and Appendix A-D).
+//
+// For each view and model: render (or load from the render cache) the
+// reference and the model, write the images (PNG, EXR, NPY), the FLIP error
+// map (colour-mapped PNG) and the RMSE map (per-channel |difference|, EXR and
+// PNG), and collect FLIP and RMSE into tables laid out like the thesis's
+// appendices: rows = views, columns = models, the best (lowest) of each row
+// named in a last column "best". Radiance uses HDR-FLIP on the linear images;
+// transmittance uses LDR-FLIP (values in [0, 1]), as the thesis did.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "atmos/atmosphere.h"
+#include "atmos/model.h"
+#include "atmos/view.h"
+#include "harness/loc.h"
+#include "metrics/flip.h"
+
+namespace atmos {
+
+struct CompareConfig {
+    std::vector<std::string>
+        models;  // empty: every registered model with the quantity, but `reference`
+    std::vector<std::string> views;  // empty: DefaultCompareViews(quantity)
+    int width = 320;
+    int height = 180;
+    Quantity quantity = Quantity::kRadiance;
+    std::string reference_model = "naive";
+    std::map<std::string, std::string> reference_options;
+    std::string reference_note;  // how the reference was chosen (shown in the report)
+    std::string atmosphere_name = "earth";
+    AtmosphereParameters atmosphere;
+    std::string output_dir = "out";
+    std::string cache_dir;  // empty: no cache
+    FlipOptions flip;
+    bool write_npy = true;
+    bool show_progress = true;
+    std::string command_line;  // for the report
+};
+
+struct CompareCell {
+    double flip = 0.0;
+    double rmse = 0.0;
+    double render_seconds = 0.0;
+    bool cached = false;
+    std::string validity_note;  // non-empty: the view is outside the model's declared validity
+    std::string image_png;      // paths relative to the output directory
+    std::string flip_png;
+    std::string rmse_png;
+};
+
+struct CompareRow {
+    std::string view;   // the view's name
+    std::string label;  // the table's row label (transmittance: ground, plane, ...)
+    std::string description;
+    std::string reference_png;
+    double reference_seconds = 0.0;
+    bool reference_cached = false;
+    std::vector<CompareCell> cells;  // one per model, in CompareResult::models order
+};
+
+struct CompareResult {
+    std::vector<std::string> models;
+    std::vector<std::string> model_titles;
+    std::vector<double> prepare_seconds;  // per model; 0 when every image came from the cache
+    std::vector<bool> prepared;
+    double reference_prepare_seconds = 0.0;
+    std::vector<CompareRow> rows;
+    std::vector<ModelLoc> loc;  // per model, plus the reference model last
+    double total_seconds = 0.0;
+    int threads = 0;
+};
+
+// The default views: all 12 for radiance; for transmittance the thesis's five
+// camera positions (Appendix C/D), which do not depend on the sun.
+std::vector<std::string> DefaultCompareViews(Quantity quantity);
+// The table row label of a view (transmittance: ground-noon -> ground, ...).
+std::string CompareRowLabel(const std::string& view, Quantity quantity);
+// Why `view` lies outside the model's declared validity, or "" if it does not.
+std::string ValidityNote(const ModelCapabilities& caps, const View& view,
+                         const AtmosphereParameters& atmosphere);
+
+// Runs the comparison and writes images, error maps, flip.csv, rmse.csv,
+// times.csv and index.html into config.output_dir. Throws atmos::Error.
+CompareResult RunCompare(const CompareConfig& config);
+
+// A metric table as CSV (thesis Appendix A/B layout): the header
+// "<corner>,<model>...,best", then one row per view with the values (%.8g)
+// and the name of the model with the lowest value.
+void WriteMetricCsv(const std::string& path, const std::string& corner,
+                    const std::vector<std::string>& row_labels,
+                    const std::vector<std::string>& columns,
+                    const std::vector<std::vector<double>>& values);
+// Index of the lowest finite value of a row (-1 if none).
+int BestIndex(const std::vector<double>& row);
+
+}  // namespace atmos

@@ -1,0 +1,163 @@
+// atmos: significant lines of code (seed 003 section 11.7; rules in loc.h).
+#include "harness/loc.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "atmos/error.h"
+
+namespace fs = std::filesystem;
+
+namespace atmos {
+
+namespace {
+
+std::string Trim(const std::string& s) {
+    const size_t a = s.find_first_not_of(" \t\r\f\v");
+    if (a == std::string::npos) return "";
+    const size_t b = s.find_last_not_of(" \t\r\f\v");
+    return s.substr(a, b - a + 1);
+}
+
+bool StartsWith(const std::string& s, const std::string& prefix) {
+    return s.compare(0, prefix.size(), prefix) == 0;
+}
+
+bool IsSetup(const std::string& code) {
+    if (code[0] == '#') return true;
+    if (StartsWith(code, "namespace ") || code == "namespace {" || code == "namespace{") {
+        return true;
+    }
+    if (code == "public:" || code == "private:" || code == "protected:") return true;
+    return StartsWith(code, "using namespace ");
+}
+
+}  // namespace
+
+int CountSignificantLines(const std::string& text) {
+    std::istringstream in(text);
+    std::string line;
+    bool in_block_comment = false;
+    int count = 0;
+    while (std::getline(in, line)) {
+        // Strip comments, keeping string and character literals.
+        std::string code;
+        char quote = 0;
+        for (size_t i = 0; i < line.size(); ++i) {
+            const char c = line[i];
+            const char next = i + 1 < line.size() ? line[i + 1] : '\0';
+            if (in_block_comment) {
+                if (c == '*' && next == '/') {
+                    in_block_comment = false;
+                    ++i;
+                }
+                continue;
+            }
+            if (quote != 0) {
+                code += c;
+                if (c == '\\' && i + 1 < line.size()) {
+                    code += next;
+                    ++i;
+                } else if (c == quote) {
+                    quote = 0;
+                }
+                continue;
+            }
+            if (c == '/' && next == '/') break;
+            if (c == '/' && next == '*') {
+                in_block_comment = true;
+                ++i;
+                code += ' ';
+                continue;
+            }
+            if (c == '"' || c == '\'') quote = c;
+            code += c;
+        }
+        code = Trim(code);
+        if (code.empty()) continue;
+        if (code.find_first_not_of("{}()[];, \t") == std::string::npos) continue;
+        if (IsSetup(code)) continue;
+        ++count;
+    }
+    return count;
+}
+
+int CountSignificantLinesInFile(const std::string& path) {
+    std::ifstream f(path);
+    if (!f) Fail("cannot read '", path, "'");
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return CountSignificantLines(ss.str());
+}
+
+std::vector<std::string> ModelSourceFiles(const std::string& source_dir, const std::string& name) {
+    std::string stem = name;
+    std::replace(stem.begin(), stem.end(), '-', '_');
+    std::vector<std::string> files;
+    const fs::path dir = fs::path(source_dir) / "src" / "atmos" / "models";
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) return files;
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+        if (!entry.is_regular_file()) continue;
+        const std::string file = entry.path().filename().string();
+        const std::string ext = entry.path().extension().string();
+        if (ext != ".h" && ext != ".cpp" && ext != ".cu") continue;
+        const std::string base = entry.path().stem().string();
+        if (base == stem || StartsWith(base, stem + "_")) {
+            files.push_back((fs::path("src") / "atmos" / "models" / file).string());
+        }
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+int ThesisLoc(const std::string& model, std::string* thesis_name) {
+    // Seed 003 section 12.4, "significant lines of code".
+    struct Row {
+        const char* prefix;
+        const char* name;
+        int lines;
+    };
+    static const Row kRows[] = {
+        {"preetham", "Preetham, Shirley and Smits", 58},
+        {"flat", "Flat", 58},
+        {"raymarched", "Raymarched", 74},
+        {"neural", "Neural network", 94},
+        {"schuler", "Schuler", 106},
+        {"naive", "Naive", 118},
+        {"reference", "Path tracer", 147},
+        {"path", "Path tracer", 147},
+        {"hillaire", "Hillaire", 208},
+        {"bruneton", "Bruneton and Neyret", 832},
+    };
+    for (const Row& r : kRows) {
+        if (StartsWith(model, r.prefix)) {
+            if (thesis_name != nullptr) *thesis_name = r.name;
+            return r.lines;
+        }
+    }
+    return -1;
+}
+
+ModelLoc CountModelLoc(const std::string& source_dir, const std::string& name) {
+    ModelLoc loc;
+    loc.model = name;
+    loc.files = ModelSourceFiles(source_dir, name);
+    for (const std::string& f : loc.files) {
+        loc.lines += CountSignificantLinesInFile((fs::path(source_dir) / f).string());
+    }
+    loc.thesis_lines = ThesisLoc(name, &loc.thesis_name);
+    return loc;
+}
+
+std::string DefaultSourceDir() {
+#ifdef ATMOS_SOURCE_DIR
+    return ATMOS_SOURCE_DIR;
+#else
+    return ".";
+#endif
+}
+
+}  // namespace atmos

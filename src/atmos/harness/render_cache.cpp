@@ -1,0 +1,87 @@
+// atmos: the on-disk render cache (see render_cache.h).
+#include "harness/render_cache.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "atmos/error.h"
+
+namespace fs = std::filesystem;
+
+namespace atmos {
+
+std::string RenderKeyText(const RenderKey& key) {
+    std::ostringstream os;
+    os << "atmos-render-cache 1\n";
+    os << "model " << key.model << "\n";
+    for (const auto& [name, value] : key.options) os << "option " << name << "=" << value << "\n";
+    os << "view " << key.view << "\n";
+    os << "size " << key.width << "x" << key.height << "\n";
+    os << "quantity " << QuantityName(key.quantity) << "\n";
+    os << "atmosphere " << key.atmosphere_json << "\n";
+    return os.str();
+}
+
+std::uint64_t Fnv1a64(const std::string& text) {
+    std::uint64_t h = 14695981039346656037ull;
+    for (unsigned char c : text) {
+        h ^= c;
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+std::map<std::string, std::string> ResolvedModelOptions(
+    const std::string& model, const std::map<std::string, std::string>& given) {
+    const ModelInfo& info = GetModelInfo(model);
+    return ModelOptions(info.name, info.options, given).values();
+}
+
+RenderCache::RenderCache(std::string directory) : directory_(std::move(directory)) {}
+
+std::string RenderCache::ImagePath(const RenderKey& key) const {
+    char hash[17];
+    std::snprintf(hash, sizeof hash, "%016llx",
+                  static_cast<unsigned long long>(Fnv1a64(RenderKeyText(key))));
+    const std::string stem = key.model + "-" + key.view + "-" + hash;
+    return (fs::path(directory_) / (stem + ".exr")).string();
+}
+
+bool RenderCache::Load(const RenderKey& key, Image* image, double* render_seconds) const {
+    if (!enabled()) return false;
+    const std::string exr = ImagePath(key);
+    const std::string meta = exr.substr(0, exr.size() - 4) + ".json";
+    std::error_code ec;
+    if (!fs::exists(exr, ec) || !fs::exists(meta, ec)) return false;
+    try {
+        std::ifstream f(meta);
+        const nlohmann::json j = nlohmann::json::parse(f);
+        if (j.at("key").get<std::string>() != RenderKeyText(key)) return false;
+        Image loaded = ReadImage(exr);
+        if (loaded.width() != key.width || loaded.height() != key.height) return false;
+        *image = std::move(loaded);
+        *render_seconds = j.at("render_seconds").get<double>();
+        return true;
+    } catch (const std::exception&) {
+        return false;  // a damaged entry is re-rendered (and overwritten)
+    }
+}
+
+void RenderCache::Store(const RenderKey& key, const Image& image, double render_seconds) const {
+    if (!enabled()) return;
+    fs::create_directories(directory_);
+    const std::string exr = ImagePath(key);
+    const std::string meta = exr.substr(0, exr.size() - 4) + ".json";
+    WriteImage(image, exr);
+    nlohmann::json j;
+    j["key"] = RenderKeyText(key);
+    j["render_seconds"] = render_seconds;
+    std::ofstream f(meta);
+    f << j.dump(1) << "\n";
+    if (!f) Fail("cannot write '", meta, "'");
+}
+
+}  // namespace atmos

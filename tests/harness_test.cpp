@@ -1,0 +1,232 @@
+// Tests of the comparison harness: metric CSV layout, lines-of-code counter,
+// render cache, validity flags, and the `flip` / `rmse` / `compare` / `loc` CLI.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "atmos/atmosphere.h"
+#include "atmos/image.h"
+#include "atmos/model.h"
+#include "atmos/view.h"
+#include "harness/compare.h"
+#include "harness/loc.h"
+#include "harness/render_cache.h"
+
+namespace fs = std::filesystem;
+
+namespace atmos {
+namespace {
+
+fs::path TempDir(const std::string& name) {
+    const char* env = std::getenv("ATMOS_TEST_TMP");
+    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
+    dir /= "harness_" + name + "_" + std::to_string(getpid());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::string Slurp(const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+struct CliRun {
+    int status = -1;
+    std::string out, err;
+};
+CliRun Atmos(const std::string& args, const fs::path& dir) {
+    const fs::path out = dir / "stdout", err = dir / "stderr";
+    const std::string cmd =
+        std::string(ATMOS_CLI_PATH) + " " + args + " > " + out.string() + " 2> " + err.string();
+    const int raw = std::system(cmd.c_str());
+    CliRun r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = Slurp(out);
+    r.err = Slurp(err);
+    return r;
+}
+
+// The last number printed on stdout.
+double LastNumber(const std::string& text) {
+    size_t end = text.find_last_of("0123456789");
+    EXPECT_NE(end, std::string::npos);
+    size_t begin = text.find_last_not_of("0123456789.e-+", end);
+    return std::stod(text.substr(begin + 1, end - begin));
+}
+
+TEST(MetricCsv, LayoutLikeTheThesisAppendix) {
+    const fs::path dir = TempDir("csv");
+    const fs::path path = dir / "flip.csv";
+    WriteMetricCsv(path.string(), "FLIP errors", {"ground-dawn", "space"}, {"a", "b", "c"},
+                   {{0.5, 0.25, 0.75}, {0.125, std::nan(""), 0.0625}});
+    EXPECT_EQ(Slurp(path),
+              "FLIP errors,a,b,c,best\n"
+              "ground-dawn,0.5,0.25,0.75,b\n"
+              "space,0.125,,0.0625,c\n");
+    EXPECT_EQ(BestIndex({std::nan(""), 3.0, 2.0}), 2);
+    EXPECT_EQ(BestIndex({std::nan("")}), -1);
+}
+
+TEST(Loc, FixtureFileHasTheKnownCount) {
+    const std::string fixture = DefaultSourceDir() + "/tests/data/loc_fixture.cpp";
+    EXPECT_EQ(CountSignificantLinesInFile(fixture), 8);
+    EXPECT_EQ(CountSignificantLines("}\n);\n  \n// x\n/* y */\nint a;\n#define Q 1\n"), 1);
+    EXPECT_EQ(CountSignificantLines("/* open\nint hidden;\n*/ int shown;\n"), 1);
+}
+
+TEST(Loc, FindsAModelsOwnFiles) {
+    const std::vector<std::string> files = ModelSourceFiles(DefaultSourceDir(), "naive");
+    ASSERT_EQ(files.size(), 2u);
+    EXPECT_EQ(files[0], "src/atmos/models/naive.cpp");
+    EXPECT_EQ(files[1], "src/atmos/models/naive.h");
+    const ModelLoc loc = CountModelLoc(DefaultSourceDir(), "naive");
+    EXPECT_GT(loc.lines, 20);
+    EXPECT_EQ(loc.thesis_lines, 118);  // seed 003 section 12.4
+    EXPECT_EQ(ThesisLoc("bruneton"), 832);
+    EXPECT_EQ(ThesisLoc("no-such-model"), -1);
+}
+
+TEST(RenderCache, RoundTripAndKeying) {
+    const fs::path dir = TempDir("cache");
+    const RenderCache cache(dir.string());
+    RenderKey key;
+    key.model = "naive";
+    key.options = ResolvedModelOptions("naive", {{"steps", "4"}});
+    EXPECT_EQ(key.options.at("light-steps"), "8");  // defaults are part of the key
+    key.atmosphere_json = AtmosphereToJson(LoadAtmosphere("earth", {}));
+    key.view = "space";
+    key.width = 3;
+    key.height = 2;
+    Image img(3, 2);
+    img.Set(2, 1, Rgb(1.0f, 2.0f, 3.0f));
+    Image loaded;
+    double seconds = 0.0;
+    EXPECT_FALSE(cache.Load(key, &loaded, &seconds));
+    cache.Store(key, img, 1.5);
+    ASSERT_TRUE(cache.Load(key, &loaded, &seconds));
+    EXPECT_EQ(seconds, 1.5);
+    EXPECT_EQ(loaded.Get(2, 1).z, 3.0f);
+    RenderKey other = key;
+    other.view = "ground-noon";
+    EXPECT_FALSE(cache.Load(other, &loaded, &seconds));
+    other = key;
+    other.options["steps"] = "5";
+    EXPECT_FALSE(cache.Load(other, &loaded, &seconds));
+    other = key;
+    other.atmosphere_json = AtmosphereToJson(LoadAtmosphere("earth", {"ground_albedo=0.3"}));
+    EXPECT_FALSE(cache.Load(other, &loaded, &seconds));
+    other = key;
+    other.quantity = Quantity::kTransmittance;
+    EXPECT_FALSE(cache.Load(other, &loaded, &seconds));
+    EXPECT_FALSE(RenderCache("").Load(key, &loaded, &seconds));
+}
+
+TEST(Compare, ValidityFlags) {
+    const AtmosphereParameters atm = LoadAtmosphere("earth", {});
+    ModelCapabilities ground_only;
+    ground_only.space_views = false;
+    EXPECT_EQ(ValidityNote(ground_only, GetView("ground-noon", atm), atm), "");
+    EXPECT_NE(ValidityNote(ground_only, GetView("plane-noon", atm), atm), "");
+    EXPECT_NE(ValidityNote(ground_only, GetView("space", atm), atm), "");
+    ModelCapabilities day_only;
+    day_only.sun_below_horizon = false;
+    EXPECT_NE(ValidityNote(day_only, GetView("ground-dawn", atm), atm), "");
+    EXPECT_EQ(ValidityNote(day_only, GetView("ground-sunrise", atm), atm), "");
+    EXPECT_EQ(CompareRowLabel("plane-noon", Quantity::kTransmittance), "plane");
+    EXPECT_EQ(DefaultCompareViews(Quantity::kRadiance).size(), 12u);
+    EXPECT_EQ(DefaultCompareViews(Quantity::kTransmittance).size(), 5u);
+}
+
+TEST(Cli, FlipAndRmseOfTwoImages) {
+    const fs::path dir = TempDir("flipcli");
+    Image a(40, 30), b(40, 30);
+    for (int y = 0; y < 30; ++y) {
+        for (int x = 0; x < 40; ++x) {
+            a.Set(x, y, Rgb(0.1f * static_cast<float>(x % 7), 0.3f, 0.02f * static_cast<float>(y)));
+            b.Set(x, y, a.Get(x, y) * (x < 20 ? 1.0f : 1.5f));
+        }
+    }
+    WriteImage(a, (dir / "a.exr").string());
+    WriteImage(b, (dir / "b.npy").string());
+    WriteImage(a, (dir / "a.png").string());
+    WriteImage(b, (dir / "b.png").string());
+    CliRun same = Atmos("flip " + (dir / "a.exr").string() + " " + (dir / "a.exr").string(), dir);
+    ASSERT_EQ(same.status, 0) << same.err;
+    EXPECT_EQ(LastNumber(same.out), 0.0);
+    EXPECT_NE(same.out.find("HDR-FLIP"), std::string::npos);
+    CliRun diff = Atmos("flip " + (dir / "a.exr").string() + " " + (dir / "b.npy").string() +
+                            " -o " + (dir / "map.png").string(),
+                        dir);
+    ASSERT_EQ(diff.status, 0) << diff.err;
+    EXPECT_GT(LastNumber(diff.out), 0.01);
+    EXPECT_EQ(ReadImage((dir / "map.png").string()).width(), 40);
+    CliRun ldr = Atmos("flip " + (dir / "a.png").string() + " " + (dir / "b.png").string(), dir);
+    ASSERT_EQ(ldr.status, 0) << ldr.err;
+    EXPECT_NE(ldr.out.find("LDR-FLIP"), std::string::npos);
+    EXPECT_GT(LastNumber(ldr.out), 0.0);
+    CliRun rmse = Atmos("rmse " + (dir / "a.exr").string() + " " + (dir / "a.exr").string(), dir);
+    ASSERT_EQ(rmse.status, 0) << rmse.err;
+    EXPECT_EQ(LastNumber(rmse.out), 0.0);
+    Image c(40, 31);
+    WriteImage(c, (dir / "c.exr").string());
+    CliRun bad = Atmos("flip " + (dir / "a.exr").string() + " " + (dir / "c.exr").string(), dir);
+    EXPECT_EQ(bad.status, 2);
+    EXPECT_NE(bad.err.find("same size"), std::string::npos);
+    CliRun bad_tm = Atmos(
+        "flip " + (dir / "a.exr").string() + " " + (dir / "a.exr").string() + " --tonemapper nope",
+        dir);
+    EXPECT_EQ(bad_tm.status, 2);
+}
+
+TEST(Cli, LocCountsTheFixture) {
+    const fs::path dir = TempDir("loccli");
+    CliRun r = Atmos("loc --file " + DefaultSourceDir() + "/tests/data/loc_fixture.cpp", dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(LastNumber(r.out), 8.0);
+    CliRun m = Atmos("loc naive", dir);
+    ASSERT_EQ(m.status, 0) << m.err;
+    EXPECT_NE(m.out.find("naive.cpp"), std::string::npos);
+}
+
+TEST(Cli, CompareWritesTablesImagesAndUsesTheCache) {
+    const fs::path dir = TempDir("compare");
+    const std::string args =
+        "compare --models empty,naive --views ground-noon,space --size 24x14 --reference naive "
+        "--reference-option steps=24 --reference-option light-steps=8 --cache " +
+        (dir / "cache").string() + " -o " + (dir / "out").string();
+    CliRun first = Atmos(args, dir);
+    ASSERT_EQ(first.status, 0) << first.err;
+    const std::string flip = Slurp(dir / "out" / "flip.csv");
+    EXPECT_EQ(flip.substr(0, flip.find('\n')), "FLIP errors,empty,naive,best");
+    EXPECT_NE(flip.find("\nground-noon,"), std::string::npos);
+    EXPECT_NE(flip.find("\nspace,"), std::string::npos);
+    EXPECT_EQ(Slurp(dir / "out" / "rmse.csv").substr(0, 28), "RMSE errors,empty,naive,best");
+    for (const char* f : {"images/space/reference.png", "images/space/naive.exr",
+                          "images/space/naive.npy", "errors/space/naive-flip.png",
+                          "errors/space/empty-rmse.exr", "index.html", "times.csv"}) {
+        EXPECT_TRUE(fs::exists(dir / "out" / f)) << f;
+    }
+    EXPECT_EQ(first.err.find("cached"), std::string::npos);
+    CliRun second = Atmos(args, dir);
+    ASSERT_EQ(second.status, 0) << second.err;
+    EXPECT_NE(second.err.find("reference (naive) cached"), std::string::npos) << second.err;
+    EXPECT_EQ(Slurp(dir / "out" / "flip.csv"), flip);  // same images -> same numbers
+    CliRun bad = Atmos("compare --models nope -o " + (dir / "x").string(), dir);
+    EXPECT_EQ(bad.status, 2);
+    CliRun spp =
+        Atmos("compare --reference naive --reference-spp 4 -o " + (dir / "x").string(), dir);
+    EXPECT_EQ(spp.status, 2);
+}
+
+}  // namespace
+}  // namespace atmos
