@@ -1,0 +1,495 @@
+// atmos model `bruneton`: the precomputation (seed 004, every "Precomputation"
+// section, and the order loop of Bruneton's model: transmittance, direct
+// irradiance, single scattering, then per order n >= 2 the scattering density,
+// the indirect irradiance of order n - 1 and the multiple scattering of order n).
+// All stages run through the project's one ParallelFor.
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "atmos/error.h"
+#include "base/parallel.h"
+#include "models/bruneton.h"
+#include "physics/transmittance.h"
+
+namespace atmos {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// Seed 004: the number of intervals of each numerical integral.
+constexpr int kTransmittanceSamples = 500;   // ComputeOpticalLengthToTopAtmosphereBoundary
+constexpr int kMaxScatteringSamples = 1000;  // seed 004 uses 50 (the default)
+constexpr int kDensityThetaSamples = 16;     // ComputeScatteringDensity: SAMPLE_COUNT
+constexpr int kIrradianceSampleCount = 32;   // ComputeIndirectIrradiance: SAMPLE_COUNT
+constexpr int kDirections = kDensityThetaSamples * 2 * kDensityThetaSamples;  // 512
+constexpr int kLanes = 8;  // independent partial sums, so the inner loop vectorises
+
+Vec4f ToVec4(const Rgb& c, float w = 0.0f) { return {c.x, c.y, c.z, w}; }
+
+// Rows of the 3D scattering table: one (mu, r) pair = (y, z), NU * MU_S texels.
+int RowCount(const BrunetonConfig& c) { return c.scattering_mu * c.scattering_r; }
+
+// Trapezoid weights of seed 004 (0.5 at both ends).
+double TrapezoidWeight(int i, int n) { return (i == 0 || i == n) ? 0.5 : 1.0; }
+
+// ---- transmittance (seed 004 ComputeTransmittanceToTopAtmosphereBoundaryTexture) ----
+void ComputeTransmittance(const BrunetonLut& lut, Table* out) {
+    const int w = lut.cfg.transmittance_width;
+    const int h = lut.cfg.transmittance_height;
+    out->Resize(w, h, 1, 3);
+    ParallelFor(h, 1, [&](int64_t yy) {
+        const int y = static_cast<int>(yy);
+        for (int x = 0; x < w; ++x) {
+            double r, mu;
+            lut.RMuFromTransmittanceUv((x + 0.5) / w, (y + 0.5) / h, &r, &mu);
+            const Vec3d tau =
+                OpticalDepthToTopAtmosphereBoundary(lut.atm, r, mu, kTransmittanceSamples);
+            out->Set(x, y, 0, ToVec4(Rgb(Exp(-tau))));
+        }
+    });
+}
+
+// ---- direct irradiance (seed 004 ComputeDirectIrradianceTexture) ----
+void ComputeDirectIrradianceTable(const BrunetonLut& lut, Table* out) {
+    const int w = lut.cfg.irradiance_width;
+    const int h = lut.cfg.irradiance_height;
+    out->Resize(w, h, 1, 3);
+    ParallelFor(h, 1, [&](int64_t yy) {
+        const int y = static_cast<int>(yy);
+        for (int x = 0; x < w; ++x) {
+            double r, mu_s;
+            lut.RMuSFromIrradianceUv((x + 0.5) / w, (y + 0.5) / h, &r, &mu_s);
+            out->Set(x, y, 0, ToVec4(lut.DirectIrradiance(r, mu_s)));
+        }
+    });
+}
+
+// ---- single scattering (seed 004 ComputeSingleScattering(Texture)) ----
+// Per row (r, mu): the view-ray samples (distance, transmittance from the
+// camera, densities) are shared by the row's (mu_s, nu) texels; only the sun's
+// transmittance depends on them.
+void ComputeSingleScatteringTables(const BrunetonLut& lut, Table* rayleigh, Table* mie) {
+    const BrunetonConfig& c = lut.cfg;
+    const int width = c.scattering_nu * c.scattering_mu_s;
+    rayleigh->Resize(width, c.scattering_mu, c.scattering_r, 3);
+    mie->Resize(width, c.scattering_mu, c.scattering_r, 3);
+    const AtmosphereParameters& atm = lut.atm;
+    ParallelFor(RowCount(c), 1, [&](int64_t row) {
+        const int y = static_cast<int>(row % c.scattering_mu);
+        const int z = static_cast<int>(row / c.scattering_mu);
+        double r, mu, mu_s, nu;
+        bool ground;
+        lut.RMuMuSNuFromTexel(0, y, z, &r, &mu, &mu_s, &nu, &ground);
+        const int n = lut.cfg.scattering_samples;
+        const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
+        double d_i[kMaxScatteringSamples + 1], r_i[kMaxScatteringSamples + 1];
+        Rgb t_r[kMaxScatteringSamples + 1], t_m[kMaxScatteringSamples + 1];
+        for (int i = 0; i <= n; ++i) {
+            const double d = i * dx;
+            d_i[i] = d;
+            r_i[i] = lut.ClampRadius(Sqrt(d * d + 2.0 * r * mu * d + r * r));
+            const Rgb t = lut.Transmittance(r, mu, d, ground);
+            const double alt = r_i[i] - atm.bottom_radius;
+            const float w = static_cast<float>(TrapezoidWeight(i, n));
+            t_r[i] = t * static_cast<float>(GetProfileDensity(atm.rayleigh_density, alt)) * w;
+            t_m[i] = t * static_cast<float>(GetProfileDensity(atm.mie_density, alt)) * w;
+        }
+        const Rgb beta_r = Rgb(atm.rayleigh_scattering * dx);
+        const Rgb beta_m = Rgb(atm.mie_scattering * dx);
+        for (int x = 0; x < width; ++x) {
+            double r2, mu2;
+            lut.RMuMuSNuFromTexel(x, y, z, &r2, &mu2, &mu_s, &nu, &ground);
+            Rgb sum_r, sum_m;
+            for (int i = 0; i <= n; ++i) {
+                const double mu_s_d = ClampCosine((r * mu_s + d_i[i] * nu) / r_i[i]);
+                const Rgb ts = lut.TransmittanceToSun(r_i[i], mu_s_d);
+                sum_r += ts * t_r[i];
+                sum_m += ts * t_m[i];
+            }
+            rayleigh->Set(x, y, z, ToVec4(sum_r * beta_r));
+            mie->Set(x, y, z, ToVec4(sum_m * beta_m));
+        }
+    });
+}
+
+// The fixed grid of incident directions of the scattering density (seed 004
+// ComputeScatteringDensity: 16 theta x 32 phi midpoints), in a frame whose x
+// axis is the sun's azimuth.
+struct DirectionGrid {
+    float wx[kDirections], wy[kDirections], wz[kDirections];
+    double solid_angle[kDirections];
+    DirectionGrid() {
+        const double dtheta = kPi / kDensityThetaSamples;
+        const double dphi = kPi / kDensityThetaSamples;
+        for (int l = 0; l < kDensityThetaSamples; ++l) {
+            const double theta = (l + 0.5) * dtheta;
+            for (int m = 0; m < 2 * kDensityThetaSamples; ++m) {
+                const double phi = (m + 0.5) * dphi;
+                const int k = l * 2 * kDensityThetaSamples + m;
+                wx[k] = static_cast<float>(std::cos(phi) * std::sin(theta));
+                wy[k] = static_cast<float>(std::sin(phi) * std::sin(theta));
+                wz[k] = static_cast<float>(std::cos(theta));
+                solid_angle[k] = dtheta * dphi * std::sin(theta);
+            }
+        }
+    }
+};
+
+// Incident radiance L_i(r, mu_s, omega_i) after n - 1 bounces times d omega_i
+// (seed 004 ComputeScatteringDensity, the inner part that does not depend on
+// the view direction), for one (r, mu_s) pair: channel-major arrays.
+struct IncidentRadiance {
+    float l[3][kDirections];
+};
+
+struct DensityInputs {
+    const TableView* single_rayleigh;
+    const TableView* single_mie;
+    const TableView* multiple;           // order n - 1 when n > 2
+    const TableView* ground_irradiance;  // ground irradiance after n - 2 bounces
+    int order;                           // n
+};
+
+void ComputeIncident(const BrunetonLut& lut, const DirectionGrid& grid, const DensityInputs& in,
+                     double r, double mu_s, IncidentRadiance* out) {
+    const AtmosphereParameters& atm = lut.atm;
+    const double sin_s = SafeSqrt(1.0 - mu_s * mu_s);
+    const Vec3d omega_s(sin_s, 0.0, mu_s);
+    const double phase_g = atm.mie_phase_g;
+    for (int l = 0; l < kDensityThetaSamples; ++l) {
+        const int k0 = l * 2 * kDensityThetaSamples;
+        const double theta = (l + 0.5) * kPi / kDensityThetaSamples;
+        const double ct = std::cos(theta);  // the double value of wz
+        const bool ground = RayIntersectsGround(r, ct, atm.bottom_radius);
+        double distance_to_ground = 0.0;
+        Rgb transmittance_to_ground(0.0f);
+        if (ground) {
+            distance_to_ground = DistanceToBottomAtmosphereBoundary(r, ct, atm.bottom_radius);
+            transmittance_to_ground = lut.Transmittance(r, ct, distance_to_ground, true);
+        }
+        for (int m = 0; m < 2 * kDensityThetaSamples; ++m) {
+            const int k = k0 + m;
+            const double phi = (m + 0.5) * kPi / kDensityThetaSamples;
+            const Vec3d omega_i(std::cos(phi) * std::sin(theta), std::sin(phi) * std::sin(theta),
+                                ct);
+            const double nu1 = ClampCosine(Dot(omega_s, omega_i));
+            Rgb incident;
+            if (in.order == 2) {
+                const Rgb ray =
+                    lut.GetScattering(*in.single_rayleigh, r, ct, mu_s, nu1, ground).rgb();
+                const Rgb mie = lut.GetScattering(*in.single_mie, r, ct, mu_s, nu1, ground).rgb();
+                incident = ray * static_cast<float>(RayleighPhase(nu1)) +
+                           mie * static_cast<float>(CornetteShanksPhase(phase_g, nu1));
+            } else {
+                incident = lut.GetScattering(*in.multiple, r, ct, mu_s, nu1, ground).rgb();
+            }
+            if (ground && MaxComponent(atm.ground_albedo) > 0.0) {
+                // Light whose (n - 1)-th bounce is on the ground (Lambertian).
+                const Vec3d normal = Normalize(Vec3d(0.0, 0.0, r) + omega_i * distance_to_ground);
+                const Rgb e = lut.GetIrradiance(*in.ground_irradiance, atm.bottom_radius,
+                                                Dot(normal, omega_s));
+                incident += transmittance_to_ground * Rgb(atm.ground_albedo * (1.0 / kPi)) * e;
+            }
+            const float w = static_cast<float>(grid.solid_angle[k]);
+            out->l[0][k] = incident.x * w;
+            out->l[1][k] = incident.y * w;
+            out->l[2][k] = incident.z * w;
+        }
+    }
+}
+
+// Sum over the directions of L_i d omega times the Rayleigh and Mie phase
+// functions without their constant factors (1 + x^2 and (1 + x^2) / den^1.5).
+void PhaseSums(const DirectionGrid& grid, const IncidentRadiance& inc, float ox, float oy, float oz,
+               float g, Rgb* sum_rayleigh, Rgb* sum_mie) {
+    float ar[3][kLanes] = {}, am[3][kLanes] = {};
+    const float g2 = 1.0f + g * g;
+    const float g_2 = 2.0f * g;
+    for (int k0 = 0; k0 < kDirections; k0 += kLanes) {
+        for (int j = 0; j < kLanes; ++j) {
+            const int k = k0 + j;
+            const float x = ox * grid.wx[k] + oy * grid.wy[k] + oz * grid.wz[k];
+            const float pr = 1.0f + x * x;
+            const float den = g2 - g_2 * x;
+            const float pm = pr / (den * sqrtf(den));
+            ar[0][j] += pr * inc.l[0][k];
+            ar[1][j] += pr * inc.l[1][k];
+            ar[2][j] += pr * inc.l[2][k];
+            am[0][j] += pm * inc.l[0][k];
+            am[1][j] += pm * inc.l[1][k];
+            am[2][j] += pm * inc.l[2][k];
+        }
+    }
+    Rgb sr, sm;
+    for (int ch = 0; ch < 3; ++ch) {
+        double a = 0.0, b = 0.0;
+        for (int j = 0; j < kLanes; ++j) {
+            a += static_cast<double>(ar[ch][j]);
+            b += static_cast<double>(am[ch][j]);
+        }
+        sr[ch] = static_cast<float>(a);
+        sm[ch] = static_cast<float>(b);
+    }
+    *sum_rayleigh = sr;
+    *sum_mie = sm;
+}
+
+// ---- scattering density J_n (seed 004 ComputeScatteringDensity(Texture)) ----
+void ComputeScatteringDensityTable(const BrunetonLut& lut, const DensityInputs& in, Table* out) {
+    const BrunetonConfig& c = lut.cfg;
+    const AtmosphereParameters& atm = lut.atm;
+    const int width = c.scattering_nu * c.scattering_mu_s;
+    out->Resize(width, c.scattering_mu, c.scattering_r, 3);
+    static const DirectionGrid grid;
+    // 1. Incident radiance per (r, mu_s).
+    std::vector<IncidentRadiance> incident(static_cast<size_t>(c.scattering_r) * c.scattering_mu_s);
+    ParallelFor(static_cast<int64_t>(incident.size()), 1, [&](int64_t idx) {
+        const int z = static_cast<int>(idx / c.scattering_mu_s);
+        const int s = static_cast<int>(idx % c.scattering_mu_s);
+        double r, mu, mu_s, nu;
+        bool ground;
+        lut.RMuMuSNuFromTexel(s, c.scattering_mu / 2, z, &r, &mu, &mu_s, &nu, &ground);
+        ComputeIncident(lut, grid, in, r, mu_s, &incident[static_cast<size_t>(idx)]);
+    });
+    // 2. Per texel, the phase-weighted sums in the sun's frame.
+    const double k_r = 3.0 / (16.0 * kPi);
+    const double g = atm.mie_phase_g;
+    const double k_m = 3.0 / (8.0 * kPi) * (1.0 - g * g) / (2.0 + g * g);
+    ParallelFor(RowCount(c), 1, [&](int64_t row) {
+        const int y = static_cast<int>(row % c.scattering_mu);
+        const int z = static_cast<int>(row / c.scattering_mu);
+        for (int x = 0; x < width; ++x) {
+            double r, mu, mu_s, nu;
+            bool ground;
+            lut.RMuMuSNuFromTexel(x, y, z, &r, &mu, &mu_s, &nu, &ground);
+            // The view direction omega with omega.z = mu and omega.omega_s = nu,
+            // in the frame where omega_s = (sin_s, 0, mu_s).
+            const double sin_s = SafeSqrt(1.0 - mu_s * mu_s);
+            const double ox = sin_s == 0.0 ? 0.0 : (nu - mu * mu_s) / sin_s;
+            const double oy = SafeSqrt(1.0 - ox * ox - mu * mu);
+            Rgb sum_r, sum_m;
+            const IncidentRadiance& inc = incident[static_cast<size_t>(z) * c.scattering_mu_s +
+                                                   static_cast<size_t>(x % c.scattering_mu_s)];
+            PhaseSums(grid, inc, static_cast<float>(ox), static_cast<float>(oy),
+                      static_cast<float>(mu), static_cast<float>(g), &sum_r, &sum_m);
+            const double alt = r - atm.bottom_radius;
+            const Vec3d br =
+                atm.rayleigh_scattering * (GetProfileDensity(atm.rayleigh_density, alt) * k_r);
+            const Vec3d bm = atm.mie_scattering * (GetProfileDensity(atm.mie_density, alt) * k_m);
+            out->Set(x, y, z, ToVec4(sum_r * Rgb(br) + sum_m * Rgb(bm)));
+        }
+    });
+}
+
+// ---- indirect irradiance of order n (seed 004 ComputeIndirectIrradiance(Texture)) ----
+void ComputeIndirectIrradianceTable(const BrunetonLut& lut, const TableView& single_rayleigh,
+                                    const TableView& single_mie, const TableView& multiple,
+                                    int order, Table* out) {
+    const int w = lut.cfg.irradiance_width;
+    const int h = lut.cfg.irradiance_height;
+    out->Resize(w, h, 1, 3);
+    const int n = kIrradianceSampleCount;
+    const double dphi = kPi / n;
+    const double dtheta = kPi / n;
+    ParallelFor(static_cast<int64_t>(w) * h, 4, [&](int64_t idx) {
+        const int x = static_cast<int>(idx % w);
+        const int y = static_cast<int>(idx / w);
+        double r, mu_s;
+        lut.RMuSFromIrradianceUv((x + 0.5) / w, (y + 0.5) / h, &r, &mu_s);
+        const Vec3d omega_s(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
+        Vec3d sum;
+        for (int j = 0; j < n / 2; ++j) {
+            const double theta = (j + 0.5) * dtheta;
+            for (int i = 0; i < 2 * n; ++i) {
+                const double phi = (i + 0.5) * dphi;
+                const Vec3d omega(std::cos(phi) * std::sin(theta), std::sin(phi) * std::sin(theta),
+                                  std::cos(theta));
+                const double domega = dtheta * dphi * std::sin(theta);
+                const double nu = ClampCosine(Dot(omega, omega_s));
+                Rgb l;
+                if (order == 1) {
+                    l = lut.GetScattering(single_rayleigh, r, omega.z, mu_s, nu, false).rgb() *
+                            static_cast<float>(RayleighPhase(nu)) +
+                        lut.GetScattering(single_mie, r, omega.z, mu_s, nu, false).rgb() *
+                            static_cast<float>(CornetteShanksPhase(lut.atm.mie_phase_g, nu));
+                } else {
+                    l = lut.GetScattering(multiple, r, omega.z, mu_s, nu, false).rgb();
+                }
+                sum += Vec3d(l) * (omega.z * domega);
+            }
+        }
+        out->Set(x, y, 0, ToVec4(Rgb(sum)));
+    });
+}
+
+// ---- multiple scattering of order n (seed 004 ComputeMultipleScattering(Texture)) ----
+// Per row (r, mu): the samples' transmittance from the camera and the (mu, r)
+// part of their table coordinates are shared by the row's texels.
+void ComputeMultipleScatteringTable(const BrunetonLut& lut, const TableView& density, Table* out) {
+    const BrunetonConfig& c = lut.cfg;
+    const int width = c.scattering_nu * c.scattering_mu_s;
+    out->Resize(width, c.scattering_mu, c.scattering_r, 3);
+    ParallelFor(RowCount(c), 1, [&](int64_t row) {
+        const int y = static_cast<int>(row % c.scattering_mu);
+        const int z = static_cast<int>(row / c.scattering_mu);
+        double r, mu, mu_s, nu;
+        bool ground;
+        lut.RMuMuSNuFromTexel(0, y, z, &r, &mu, &mu_s, &nu, &ground);
+        const int n = lut.cfg.scattering_samples;
+        const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
+        double d_i[kMaxScatteringSamples + 1], r_i[kMaxScatteringSamples + 1];
+        double u_mu[kMaxScatteringSamples + 1], u_r[kMaxScatteringSamples + 1];
+        Rgb t_i[kMaxScatteringSamples + 1];
+        for (int i = 0; i <= n; ++i) {
+            const double d = i * dx;
+            d_i[i] = d;
+            r_i[i] = lut.ClampRadius(Sqrt(d * d + 2.0 * r * mu * d + r * r));
+            const double mu_i = ClampCosine((r * mu + d) / r_i[i]);
+            lut.ScatteringUMuR(r_i[i], mu_i, ground, &u_mu[i], &u_r[i]);
+            t_i[i] = lut.Transmittance(r, mu, d, ground) *
+                     static_cast<float>(TrapezoidWeight(i, n) * dx);
+        }
+        for (int x = 0; x < width; ++x) {
+            double r2, mu2;
+            lut.RMuMuSNuFromTexel(x, y, z, &r2, &mu2, &mu_s, &nu, &ground);
+            Rgb sum;
+            for (int i = 0; i <= n; ++i) {
+                const double mu_s_i = ClampCosine((r * mu_s + d_i[i] * nu) / r_i[i]);
+                const double uvwz[4] = {(nu + 1.0) / 2.0, lut.ScatteringUMuS(mu_s_i), u_mu[i],
+                                        u_r[i]};
+                sum += BrunetonLut::Lookup4D(density, c.scattering_nu, uvwz).rgb() * t_i[i];
+            }
+            out->Set(x, y, z, ToVec4(sum));
+        }
+    });
+}
+
+}  // namespace
+
+void ValidateBrunetonConfig(const BrunetonConfig& c) {
+    auto check = [](const char* name, int v, int lo, int hi) {
+        if (v < lo || v > hi) Fail("bruneton: --", name, " ", v, " outside [", lo, ", ", hi, "]");
+    };
+    check("transmittance-width", c.transmittance_width, 2, 4096);
+    check("transmittance-height", c.transmittance_height, 2, 4096);
+    check("irradiance-width", c.irradiance_width, 2, 4096);
+    check("irradiance-height", c.irradiance_height, 2, 4096);
+    check("scattering-r", c.scattering_r, 2, 1024);
+    check("scattering-mu", c.scattering_mu, 4, 4096);
+    check("scattering-mu-s", c.scattering_mu_s, 2, 1024);
+    check("scattering-nu", c.scattering_nu, 2, 1024);
+    check("orders", c.orders, 1, 32);
+    check("scattering-samples", c.scattering_samples, 1, kMaxScatteringSamples);
+    if (c.scattering_mu % 2 != 0) {
+        Fail("bruneton: --scattering-mu ", c.scattering_mu,
+             " must be even (half of the table is for rays that hit the ground)");
+    }
+}
+
+BrunetonLut MakeBrunetonLut(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
+                            const BrunetonTables& tables) {
+    BrunetonLut lut;
+    lut.atm = atmosphere;
+    lut.cfg = config;
+    lut.transmittance_table = tables.transmittance.view();
+    lut.irradiance_table = tables.irradiance.view();
+    lut.scattering_table = tables.scattering.view();
+    lut.single_mie_table = tables.single_mie.view();
+    return lut;
+}
+
+void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
+                        BrunetonTables* tables, BrunetonTimings* timings) {
+    ValidateBrunetonConfig(config);
+    BrunetonTimings t;
+    const auto start = Clock::now();
+    BrunetonLut lut;
+    lut.atm = atmosphere;
+    lut.cfg = config;
+
+    auto stage = Clock::now();
+    ComputeTransmittance(lut, &tables->transmittance);
+    lut.transmittance_table = tables->transmittance.view();
+    t.transmittance = SecondsSince(stage);
+
+    stage = Clock::now();
+    Table delta_irradiance;
+    ComputeDirectIrradianceTable(lut, &delta_irradiance);
+    // The irradiance table holds the indirect irradiance only (the direct one is
+    // computed at render time from the transmittance, seed 004).
+    tables->irradiance.Resize(config.irradiance_width, config.irradiance_height, 1, 3);
+    t.direct_irradiance = SecondsSince(stage);
+
+    stage = Clock::now();
+    Table delta_rayleigh, delta_mie;
+    ComputeSingleScatteringTables(lut, &delta_rayleigh, &delta_mie);
+    const int width = config.scattering_nu * config.scattering_mu_s;
+    tables->scattering.Resize(width, config.scattering_mu, config.scattering_r,
+                              config.combined_mie ? 4 : 3);
+    if (config.combined_mie) {
+        tables->single_mie = Table();
+    } else {
+        tables->single_mie = delta_mie;
+    }
+    {
+        const size_t texels =
+            static_cast<size_t>(width) * config.scattering_mu * config.scattering_r;
+        const int ch = tables->scattering.channels();
+        float* s = tables->scattering.data();
+        const float* ray = delta_rayleigh.data();
+        const float* mie = delta_mie.data();
+        for (size_t i = 0; i < texels; ++i) {
+            for (int c = 0; c < 3; ++c) s[i * ch + c] = ray[i * 3 + c];
+            if (ch == 4) s[i * 4 + 3] = mie[i * 3];
+        }
+    }
+    t.single_scattering = SecondsSince(stage);
+
+    Table delta_multiple, delta_density;
+    for (int order = 2; order <= config.orders; ++order) {
+        stage = Clock::now();
+        const DensityInputs in{&delta_rayleigh.view(), &delta_mie.view(), &delta_multiple.view(),
+                               &delta_irradiance.view(), order};
+        ComputeScatteringDensityTable(lut, in, &delta_density);
+        t.scattering_density += SecondsSince(stage);
+
+        stage = Clock::now();
+        ComputeIndirectIrradianceTable(lut, delta_rayleigh.view(), delta_mie.view(),
+                                       delta_multiple.view(), order - 1, &delta_irradiance);
+        {
+            float* e = tables->irradiance.data();
+            const float* de = delta_irradiance.data();
+            for (size_t i = 0; i < tables->irradiance.size(); ++i) e[i] += de[i];
+        }
+        t.indirect_irradiance += SecondsSince(stage);
+
+        stage = Clock::now();
+        ComputeMultipleScatteringTable(lut, delta_density.view(), &delta_multiple);
+        // Accumulate, divided by the Rayleigh phase function (the renderer
+        // multiplies the whole table by it; seed 004 "Rendering").
+        ParallelFor(RowCount(config), 4, [&](int64_t row) {
+            const int y = static_cast<int>(row % config.scattering_mu);
+            const int z = static_cast<int>(row / config.scattering_mu);
+            for (int x = 0; x < width; ++x) {
+                double r, mu, mu_s, nu;
+                bool ground;
+                lut.RMuMuSNuFromTexel(x, y, z, &r, &mu, &mu_s, &nu, &ground);
+                const float inv_phase = static_cast<float>(1.0 / RayleighPhase(nu));
+                const float* dm = delta_multiple.Texel(x, y, z);
+                float* s = tables->scattering.Texel(x, y, z);
+                for (int c = 0; c < 3; ++c) s[c] += dm[c] * inv_phase;
+            }
+        });
+        t.multiple_scattering += SecondsSince(stage);
+    }
+    t.total = SecondsSince(start);
+    if (timings) *timings = t;
+}
+
+}  // namespace atmos
