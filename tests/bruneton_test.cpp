@@ -6,9 +6,12 @@
 // precomputation takes well under a second; the single-scattering accuracy test
 // runs at the seed's default sizes (orders = 1 only).
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -538,6 +541,38 @@ TEST(Bruneton, BadOptionsAreRejected) {
     EXPECT_THROW(CreateModel("bruneton", {{"scattering-mu", "33"}}), Error);
     EXPECT_THROW(CreateModel("bruneton", {{"orders", "0"}}), Error);
     EXPECT_THROW(CreateModel("bruneton", {{"mie-storage", "both"}}), Error);
+}
+
+TEST(Bruneton, CliBakeThenRenderFromTheBake) {
+    // `atmos bake --model bruneton -o DIR`, then `render --load DIR`; a load for
+    // another atmosphere fails with a message and a non-zero exit.
+    namespace fs = std::filesystem;
+    const fs::path dir =
+        fs::path(ATMOS_TEST_TMP) / ("bruneton_cli_" + std::to_string(static_cast<long>(getpid())));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string cli = ATMOS_CLI_PATH;
+    const std::string opts =
+        " --model bruneton --scattering-r 4 --scattering-mu 16 --scattering-mu-s 8 "
+        "--scattering-nu 4 --orders 2 -q";
+    auto run = [](const std::string& cmd) {
+        const int raw = std::system(cmd.c_str());
+        return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    };
+    ASSERT_EQ(run(cli + " bake" + opts + " -o " + (dir / "bake").string()), 0);
+    for (const char* f : {"bruneton.json", "transmittance.exr", "irradiance.exr", "scattering.exr",
+                          "single_mie_scattering.exr"}) {
+        EXPECT_TRUE(fs::exists(dir / "bake" / f)) << f;
+    }
+    EXPECT_EQ(run(cli + " render" + opts + " --view ground-sunrise --size 16x9 --load " +
+                  (dir / "bake").string() + " -o " + (dir / "a.pfm").string()),
+              0);
+    EXPECT_TRUE(fs::exists(dir / "a.pfm"));
+    EXPECT_NE(run(cli + " render" + opts + " --view ground-sunrise --size 16x9 --set " +
+                  "mie_phase_g=0.7 --load " + (dir / "bake").string() + " -o " +
+                  (dir / "b.pfm").string() + " 2> " + (dir / "err.txt").string()),
+              0);
+    fs::remove_all(dir);
 }
 
 }  // namespace

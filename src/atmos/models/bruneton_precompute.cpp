@@ -328,6 +328,71 @@ void ComputeIndirectIrradianceTable(const BrunetonLut& lut, const TableView& sin
     });
 }
 
+// The 4D lookup of BrunetonLut::Lookup4D specialised for a 3-channel table
+// (same texel-centre filtering and clamping, TableView::Split), with the mu_s
+// mapping's constants hoisted: the inner loop of the multiple scattering step.
+struct FastScatteringLookup {
+    const float* data;
+    int width, height, depth, nu_size;
+    int mu_s_size;
+    double bottom, top, d_min, d_range, big_a;
+    FastScatteringLookup(const BrunetonLut& lut, const TableView& t)
+        : data(t.data),
+          width(t.width),
+          height(t.height),
+          depth(t.depth),
+          nu_size(lut.cfg.scattering_nu),
+          mu_s_size(lut.cfg.scattering_mu_s) {
+        bottom = lut.atm.bottom_radius;
+        top = lut.atm.top_radius;
+        d_min = top - bottom;
+        d_range = lut.HorizonH() - d_min;
+        const double big_d = DistanceToTopAtmosphereBoundary(bottom, lut.atm.mu_s_min, top);
+        big_a = (big_d - d_min) / d_range;
+    }
+    // Seed 004's u_mu_s (BrunetonLut::ScatteringUMuS).
+    double UMuS(double mu_s) const {
+        const double d = DistanceToTopAtmosphereBoundary(bottom, mu_s, top);
+        const double a = (d - d_min) / d_range;
+        return GetTextureCoordFromUnitRange(Max(1.0 - a / big_a, 0.0) / (1.0 + a), mu_s_size);
+    }
+    Rgb Sample(double u_nu, double u_mu_s, double u_mu, double u_r) const {
+        const double tex_coord_x = u_nu * (nu_size - 1);
+        const double tex_x = std::floor(tex_coord_x);
+        const float lerp = static_cast<float>(tex_coord_x - tex_x);
+        int xa, xb, y0, z0;
+        float fxa, fxb, fy, fz;
+        TableView::Split((tex_x + u_mu_s) / nu_size, width, &xa, &fxa);
+        TableView::Split((tex_x + 1.0 + u_mu_s) / nu_size, width, &xb, &fxb);
+        TableView::Split(u_mu, height, &y0, &fy);
+        TableView::Split(u_r, depth, &z0, &fz);
+        const int x1a = Min(xa + 1, width - 1), x1b = Min(xb + 1, width - 1);
+        const int y1 = Min(y0 + 1, height - 1), z1 = Min(z0 + 1, depth - 1);
+        const int xs[4] = {xa, x1a, xb, x1b};
+        const float wx[4] = {(1.0f - fxa) * (1.0f - lerp), fxa * (1.0f - lerp), (1.0f - fxb) * lerp,
+                             fxb * lerp};
+        const int ys[2] = {y0, y1};
+        const float wy[2] = {1.0f - fy, fy};
+        const int zs[2] = {z0, z1};
+        const float wz[2] = {1.0f - fz, fz};
+        float acc[3] = {0.0f, 0.0f, 0.0f};
+        for (int k = 0; k < 2; ++k) {
+            for (int j = 0; j < 2; ++j) {
+                const float wzy = wz[k] * wy[j];
+                const float* row = data + (static_cast<size_t>(zs[k]) * height + ys[j]) * width * 3;
+                for (int i = 0; i < 4; ++i) {
+                    const float w = wzy * wx[i];
+                    const float* p = row + static_cast<size_t>(xs[i]) * 3;
+                    acc[0] += w * p[0];
+                    acc[1] += w * p[1];
+                    acc[2] += w * p[2];
+                }
+            }
+        }
+        return Rgb(acc[0], acc[1], acc[2]);
+    }
+};
+
 // ---- multiple scattering of order n (seed 004 ComputeMultipleScattering(Texture)) ----
 // Per row (r, mu): the samples' transmittance from the camera and the (mu, r)
 // part of their table coordinates are shared by the row's texels.
@@ -335,6 +400,7 @@ void ComputeMultipleScatteringTable(const BrunetonLut& lut, const TableView& den
     const BrunetonConfig& c = lut.cfg;
     const int width = c.scattering_nu * c.scattering_mu_s;
     out->Resize(width, c.scattering_mu, c.scattering_r, 3);
+    const FastScatteringLookup fast(lut, density);
     ParallelFor(RowCount(c), 1, [&](int64_t row) {
         const int y = static_cast<int>(row % c.scattering_mu);
         const int z = static_cast<int>(row / c.scattering_mu);
@@ -361,9 +427,7 @@ void ComputeMultipleScatteringTable(const BrunetonLut& lut, const TableView& den
             Rgb sum;
             for (int i = 0; i <= n; ++i) {
                 const double mu_s_i = ClampCosine((r * mu_s + d_i[i] * nu) / r_i[i]);
-                const double uvwz[4] = {(nu + 1.0) / 2.0, lut.ScatteringUMuS(mu_s_i), u_mu[i],
-                                        u_r[i]};
-                sum += BrunetonLut::Lookup4D(density, c.scattering_nu, uvwz).rgb() * t_i[i];
+                sum += fast.Sample((nu + 1.0) / 2.0, fast.UMuS(mu_s_i), u_mu[i], u_r[i]) * t_i[i];
             }
             out->Set(x, y, z, ToVec4(sum));
         }
