@@ -2,13 +2,15 @@
 // per-call cost of rendering from the tables.
 //
 // Run: build/bench/atmos_bench --benchmark_filter=Bruneton
-// BM_BrunetonPrecompute reports the stages (seconds, wall clock) as counters.
+// BM_BrunetonPrecompute/ORDERS/THREADS reports the stages (seconds, wall clock)
+// as counters.
 #include <benchmark/benchmark.h>
 
 #include <vector>
 
 #include "atmos/atmosphere.h"
 #include "atmos/view.h"
+#include "base/parallel.h"
 #include "models/bruneton.h"
 #include "render/render.h"
 
@@ -18,6 +20,7 @@ namespace {
 void BM_BrunetonPrecompute(benchmark::State& state) {
     BrunetonConfig config;
     config.orders = static_cast<int>(state.range(0));
+    ThreadLimit limit(static_cast<int>(state.range(1)));
     const AtmosphereParameters atm = EarthAtmosphere();
     BrunetonTimings t;
     for (auto _ : state) {
@@ -33,7 +36,13 @@ void BM_BrunetonPrecompute(benchmark::State& state) {
     state.counters["multiple_s"] = t.multiple_scattering;
     state.counters["total_s"] = t.total;
 }
-BENCHMARK(BM_BrunetonPrecompute)->Arg(4)->Unit(benchmark::kSecond)->Iterations(1);
+// Args: orders, threads (0: all cores).
+BENCHMARK(BM_BrunetonPrecompute)
+    ->Args({4, 2})
+    ->Args({4, 1})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
 
 struct Prepared {
     BrunetonTables tables;

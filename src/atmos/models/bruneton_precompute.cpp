@@ -349,12 +349,72 @@ struct FastScatteringLookup {
         d_range = lut.HorizonH() - d_min;
         const double big_d = DistanceToTopAtmosphereBoundary(bottom, lut.atm.mu_s_min, top);
         big_a = (big_d - d_min) / d_range;
+        inv_d_range = 1.0 / d_range;
+        inv_big_a = 1.0 / big_a;
+        half_texel = 0.5 / mu_s_size;
+        texel_scale = 1.0 - 1.0 / mu_s_size;
+    }
+    double inv_d_range, inv_big_a, half_texel, texel_scale;
+    // TableView::Split along x for the coordinate (tex_x + u_mu_s) / NU, i.e.
+    // texel position (tex_x + u_mu_s) * MU_S - 0.5, clamped to the edges.
+    void SplitX(double tex_x_plus_u, int* i0, float* f) const {
+        double x = tex_x_plus_u * mu_s_size - 0.5;
+        if (x < 0.0) x = 0.0;
+        if (x > width - 1) x = width - 1;
+        int i = static_cast<int>(x);
+        if (i > width - 2) i = width - 2;
+        *i0 = i;
+        *f = static_cast<float>(x - i);
     }
     // Seed 004's u_mu_s (BrunetonLut::ScatteringUMuS).
+    // Divisions by constants hoisted (the inner loop is division bound).
     double UMuS(double mu_s) const {
         const double d = DistanceToTopAtmosphereBoundary(bottom, mu_s, top);
-        const double a = (d - d_min) / d_range;
-        return GetTextureCoordFromUnitRange(Max(1.0 - a / big_a, 0.0) / (1.0 + a), mu_s_size);
+        const double a = (d - d_min) * inv_d_range;
+        return half_texel + Max(1.0 - a * inv_big_a, 0.0) / (1.0 + a) * texel_scale;
+    }
+    // The (mu, r) part of a lookup: four rows of texels and their weights.
+    struct Rows {
+        const float* row[4];
+        float w[4];
+    };
+    void MakeRows(double u_mu, double u_r, Rows* out) const {
+        int y0, z0;
+        float fy, fz;
+        TableView::Split(u_mu, height, &y0, &fy);
+        TableView::Split(u_r, depth, &z0, &fz);
+        const int y1 = Min(y0 + 1, height - 1), z1 = Min(z0 + 1, depth - 1);
+        const int ys[2] = {y0, y1}, zs[2] = {z0, z1};
+        const float wy[2] = {1.0f - fy, fy}, wz[2] = {1.0f - fz, fz};
+        for (int k = 0; k < 2; ++k) {
+            for (int j = 0; j < 2; ++j) {
+                out->row[k * 2 + j] =
+                    data + (static_cast<size_t>(zs[k]) * height + ys[j]) * width * 3;
+                out->w[k * 2 + j] = wz[k] * wy[j];
+            }
+        }
+    }
+    // The (nu, mu_s) part: tex_x and lerp from u_nu as in Sample().
+    Rgb SampleRows(const Rows& rows, double tex_x, float lerp, double u_mu_s) const {
+        int xa, xb;
+        float fxa, fxb;
+        SplitX(tex_x + u_mu_s, &xa, &fxa);
+        SplitX(tex_x + 1.0 + u_mu_s, &xb, &fxb);
+        const int x1a = Min(xa + 1, width - 1), x1b = Min(xb + 1, width - 1);
+        const int xs[4] = {xa, x1a, xb, x1b};
+        const float wx[4] = {(1.0f - fxa) * (1.0f - lerp), fxa * (1.0f - lerp), (1.0f - fxb) * lerp,
+                             fxb * lerp};
+        float acc[3] = {0.0f, 0.0f, 0.0f};
+        for (int k = 0; k < 4; ++k) {
+            for (int i = 0; i < 4; ++i) {
+                const float w = rows.w[k] * wx[i];
+                const float* p = rows.row[k] + static_cast<size_t>(xs[i]) * 3;
+                acc[0] += w * p[0];
+                acc[1] += w * p[1];
+                acc[2] += w * p[2];
+            }
+        }
+        return Rgb(acc[0], acc[1], acc[2]);
     }
     Rgb Sample(double u_nu, double u_mu_s, double u_mu, double u_r) const {
         const double tex_coord_x = u_nu * (nu_size - 1);
@@ -412,25 +472,41 @@ void ComputeMultipleScatteringTable(const BrunetonLut& lut, const TableView& den
         double d_i[kMaxScatteringSamples + 1], r_i[kMaxScatteringSamples + 1];
         double u_mu[kMaxScatteringSamples + 1], u_r[kMaxScatteringSamples + 1];
         Rgb t_i[kMaxScatteringSamples + 1];
+        FastScatteringLookup::Rows rows[kMaxScatteringSamples + 1];
         for (int i = 0; i <= n; ++i) {
             const double d = i * dx;
             d_i[i] = d;
             r_i[i] = lut.ClampRadius(Sqrt(d * d + 2.0 * r * mu * d + r * r));
             const double mu_i = ClampCosine((r * mu + d) / r_i[i]);
             lut.ScatteringUMuR(r_i[i], mu_i, ground, &u_mu[i], &u_r[i]);
+            fast.MakeRows(u_mu[i], u_r[i], &rows[i]);
             t_i[i] = lut.Transmittance(r, mu, d, ground) *
                      static_cast<float>(TrapezoidWeight(i, n) * dx);
         }
+        // Samples outer, texels inner: the four table rows of one sample stay in
+        // the cache while the row's texels read them.
+        std::vector<double> mu_s_x(static_cast<size_t>(width)), nu_x(mu_s_x.size());
+        std::vector<double> tex_x(mu_s_x.size());
+        std::vector<float> lerp(mu_s_x.size());
+        std::vector<Rgb> sum(mu_s_x.size());
         for (int x = 0; x < width; ++x) {
             double r2, mu2;
             lut.RMuMuSNuFromTexel(x, y, z, &r2, &mu2, &mu_s, &nu, &ground);
-            Rgb sum;
-            for (int i = 0; i <= n; ++i) {
-                const double mu_s_i = ClampCosine((r * mu_s + d_i[i] * nu) / r_i[i]);
-                sum += fast.Sample((nu + 1.0) / 2.0, fast.UMuS(mu_s_i), u_mu[i], u_r[i]) * t_i[i];
-            }
-            out->Set(x, y, z, ToVec4(sum));
+            const size_t k = static_cast<size_t>(x);
+            mu_s_x[k] = mu_s;
+            nu_x[k] = nu;
+            const double tex_coord_x = (nu + 1.0) / 2.0 * (c.scattering_nu - 1);
+            tex_x[k] = std::floor(tex_coord_x);
+            lerp[k] = static_cast<float>(tex_coord_x - tex_x[k]);
         }
+        for (int i = 0; i <= n; ++i) {
+            const double inv_r_i = 1.0 / r_i[i];
+            for (size_t k = 0; k < sum.size(); ++k) {
+                const double mu_s_i = ClampCosine((r * mu_s_x[k] + d_i[i] * nu_x[k]) * inv_r_i);
+                sum[k] += fast.SampleRows(rows[i], tex_x[k], lerp[k], fast.UMuS(mu_s_i)) * t_i[i];
+            }
+        }
+        for (int x = 0; x < width; ++x) out->Set(x, y, z, ToVec4(sum[static_cast<size_t>(x)]));
     });
 }
 
