@@ -6,6 +6,8 @@
 // as counters.
 #include <benchmark/benchmark.h>
 
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "atmos/atmosphere.h"
@@ -28,13 +30,18 @@ void BM_BrunetonPrecompute(benchmark::State& state) {
         PrecomputeBruneton(atm, config, &tables, &t);
         benchmark::DoNotOptimize(tables.scattering.data());
     }
-    state.counters["transmittance_s"] = t.transmittance;
-    state.counters["direct_irradiance_s"] = t.direct_irradiance;
-    state.counters["single_s"] = t.single_scattering;
-    state.counters["density_s"] = t.scattering_density;
-    state.counters["indirect_irradiance_s"] = t.indirect_irradiance;
-    state.counters["multiple_s"] = t.multiple_scattering;
-    state.counters["total_s"] = t.total;
+    // Wall clock, and CPU time of all threads (the machine may be shared).
+    for (const auto& [prefix, s] :
+         {std::make_pair("wall_", t.wall), std::make_pair("cpu_", t.cpu)}) {
+        const std::string p = prefix;
+        state.counters[p + "transmittance"] = s.transmittance;
+        state.counters[p + "direct_irr"] = s.direct_irradiance;
+        state.counters[p + "single"] = s.single_scattering;
+        state.counters[p + "density"] = s.scattering_density;
+        state.counters[p + "indirect_irr"] = s.indirect_irradiance;
+        state.counters[p + "multiple"] = s.multiple_scattering;
+        state.counters[p + "total"] = s.total;
+    }
 }
 // Args: orders, threads (0: all cores).
 BENCHMARK(BM_BrunetonPrecompute)

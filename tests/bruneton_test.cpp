@@ -258,16 +258,21 @@ TEST(Bruneton, OrdersDecreaseAndMultipleScatteringFraction) {
     // at noon each order is smaller than the previous one.
     // Multiple scattering fraction (luminance): noon: sky 45 deg up, 90 deg
     // from the sun at 60 deg; twilight: zenith, sun 6 deg below the horizon.
+    // One precomputation; the tables are read after each order.
+    Rgb noon[5], twilight[5], zenith[5];
+    const AtmosphereParameters atm = EarthAtmosphere();
+    const BrunetonConfig cfg = Small(4);
+    BrunetonTables tables;
+    PrecomputeBruneton(atm, cfg, &tables, nullptr, [&](int n, const BrunetonTables& t) {
+        BrunetonEvaluator e;
+        e.lut = MakeBrunetonLut(atm, cfg, t);
+        zenith[n] = Sky(e, 0.0, 1.0, 1.0);
+        noon[n] = Sky(e, 0.0, std::sqrt(0.5), std::sin(Radians(60.0)), kPi / 2);
+        twilight[n] = Sky(e, 0.0, 1.0, std::sin(Radians(-6.0)));
+    });
     Rgb prev_order;
-    Rgb noon[5], twilight[5];
     for (int n = 1; n <= 4; ++n) {
-        const Precomputed p(EarthAtmosphere(), Small(n));
-        const Rgb zenith = Sky(p.eval, 0.0, 1.0, 1.0);
-        noon[n] = Sky(p.eval, 0.0, std::sqrt(0.5), std::sin(Radians(60.0)), kPi / 2);
-        twilight[n] = Sky(p.eval, 0.0, 1.0, std::sin(Radians(-6.0)));
-        static Rgb prev_zenith;
-        const Rgb order = n == 1 ? zenith : zenith - prev_zenith;
-        prev_zenith = zenith;
+        const Rgb order = n == 1 ? zenith[1] : zenith[n] - zenith[n - 1];
         std::printf("order %d alone at the zenith at noon: %.5g %.5g %.5g\n", n,
                     static_cast<double>(order.x), static_cast<double>(order.y),
                     static_cast<double>(order.z));

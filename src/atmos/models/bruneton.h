@@ -39,6 +39,7 @@
 // horizon").
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "atmos/atmosphere.h"
@@ -474,8 +475,8 @@ struct BrunetonTables {
     Table single_mie;     // same size, 3 channels (separate storage), else empty
 };
 
-// Wall-clock seconds per precomputation stage.
-struct BrunetonTimings {
+// Seconds per precomputation stage.
+struct BrunetonStageTimes {
     double transmittance = 0.0;
     double direct_irradiance = 0.0;
     double single_scattering = 0.0;
@@ -484,11 +485,19 @@ struct BrunetonTimings {
     double multiple_scattering = 0.0;
     double total = 0.0;
 };
+struct BrunetonTimings {
+    BrunetonStageTimes wall;  // wall clock
+    BrunetonStageTimes cpu;   // process CPU time (all threads: std::clock)
+};
+
+// Called with the tables as they stand after each scattering order (1..N).
+using BrunetonOrderCallback = std::function<void(int order, const BrunetonTables& tables)>;
 
 // The whole precomputation of seed 004 on the CPU (ParallelFor). Tables are per
 // unit solar irradiance. Throws atmos::Error for an invalid configuration.
 void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
-                        BrunetonTables* tables, BrunetonTimings* timings = nullptr);
+                        BrunetonTables* tables, BrunetonTimings* timings = nullptr,
+                        const BrunetonOrderCallback& on_order = nullptr);
 
 // Checks sizes and orders; throws atmos::Error naming the bad option.
 void ValidateBrunetonConfig(const BrunetonConfig& config);

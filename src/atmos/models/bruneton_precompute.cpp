@@ -5,6 +5,7 @@
 // All stages run through the project's one ParallelFor.
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <vector>
 
 #include "atmos/error.h"
@@ -18,9 +19,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double SecondsSince(Clock::time_point t) {
-    return std::chrono::duration<double>(Clock::now() - t).count();
-}
+// Wall and CPU time of one stage, added to a field of both.
+struct Stopwatch {
+    Clock::time_point wall = Clock::now();
+    std::clock_t cpu = std::clock();
+    void AddTo(BrunetonTimings* t, double BrunetonStageTimes::*field) const {
+        t->wall.*field += std::chrono::duration<double>(Clock::now() - wall).count();
+        t->cpu.*field += static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
+    }
+};
 
 // Seed 004: the number of intervals of each numerical integral.
 constexpr int kTransmittanceSamples = 500;   // ComputeOpticalLengthToTopAtmosphereBoundary
@@ -545,28 +552,29 @@ BrunetonLut MakeBrunetonLut(const AtmosphereParameters& atmosphere, const Brunet
 }
 
 void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
-                        BrunetonTables* tables, BrunetonTimings* timings) {
+                        BrunetonTables* tables, BrunetonTimings* timings,
+                        const BrunetonOrderCallback& on_order) {
     ValidateBrunetonConfig(config);
     BrunetonTimings t;
-    const auto start = Clock::now();
+    const Stopwatch start;
     BrunetonLut lut;
     lut.atm = atmosphere;
     lut.cfg = config;
 
-    auto stage = Clock::now();
+    Stopwatch stage;
     ComputeTransmittance(lut, &tables->transmittance);
     lut.transmittance_table = tables->transmittance.view();
-    t.transmittance = SecondsSince(stage);
+    stage.AddTo(&t, &BrunetonStageTimes::transmittance);
 
-    stage = Clock::now();
+    stage = Stopwatch();
     Table delta_irradiance;
     ComputeDirectIrradianceTable(lut, &delta_irradiance);
     // The irradiance table holds the indirect irradiance only (the direct one is
     // computed at render time from the transmittance, seed 004).
     tables->irradiance.Resize(config.irradiance_width, config.irradiance_height, 1, 3);
-    t.direct_irradiance = SecondsSince(stage);
+    stage.AddTo(&t, &BrunetonStageTimes::direct_irradiance);
 
-    stage = Clock::now();
+    stage = Stopwatch();
     Table delta_rayleigh, delta_mie;
     ComputeSingleScatteringTables(lut, &delta_rayleigh, &delta_mie);
     const int width = config.scattering_nu * config.scattering_mu_s;
@@ -589,17 +597,18 @@ void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonCo
             if (ch == 4) s[i * 4 + 3] = mie[i * 3];
         }
     }
-    t.single_scattering = SecondsSince(stage);
+    stage.AddTo(&t, &BrunetonStageTimes::single_scattering);
+    if (on_order) on_order(1, *tables);
 
     Table delta_multiple, delta_density;
     for (int order = 2; order <= config.orders; ++order) {
-        stage = Clock::now();
+        stage = Stopwatch();
         const DensityInputs in{&delta_rayleigh.view(), &delta_mie.view(), &delta_multiple.view(),
                                &delta_irradiance.view(), order};
         ComputeScatteringDensityTable(lut, in, &delta_density);
-        t.scattering_density += SecondsSince(stage);
+        stage.AddTo(&t, &BrunetonStageTimes::scattering_density);
 
-        stage = Clock::now();
+        stage = Stopwatch();
         ComputeIndirectIrradianceTable(lut, delta_rayleigh.view(), delta_mie.view(),
                                        delta_multiple.view(), order - 1, &delta_irradiance);
         {
@@ -607,9 +616,9 @@ void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonCo
             const float* de = delta_irradiance.data();
             for (size_t i = 0; i < tables->irradiance.size(); ++i) e[i] += de[i];
         }
-        t.indirect_irradiance += SecondsSince(stage);
+        stage.AddTo(&t, &BrunetonStageTimes::indirect_irradiance);
 
-        stage = Clock::now();
+        stage = Stopwatch();
         ComputeMultipleScatteringTable(lut, delta_density.view(), &delta_multiple);
         // Accumulate, divided by the Rayleigh phase function (the renderer
         // multiplies the whole table by it; seed 004 "Rendering").
@@ -626,9 +635,10 @@ void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonCo
                 for (int c = 0; c < 3; ++c) s[c] += dm[c] * inv_phase;
             }
         });
-        t.multiple_scattering += SecondsSince(stage);
+        stage.AddTo(&t, &BrunetonStageTimes::multiple_scattering);
+        if (on_order) on_order(order, *tables);
     }
-    t.total = SecondsSince(start);
+    start.AddTo(&t, &BrunetonStageTimes::total);
     if (timings) *timings = t;
 }
 
