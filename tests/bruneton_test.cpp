@@ -389,6 +389,41 @@ TEST(Bruneton, GroundIsLitOnlyWithAlbedo) {
     EXPECT_GT(sky_grey.z, sky_black.z);
 }
 
+TEST(Bruneton, SkyIrradianceMatchesHemisphereIntegralOfSkyRadiance) {
+    // The irradiance table (orders 1..N-1 of the sky on a horizontal surface,
+    // seed 004) against a numerical integral of the model's own sky radiance
+    // (orders 1..N) over the upper hemisphere, cosine-weighted: they differ by
+    // the last order (small) and the quadratures.
+    const Precomputed p(EarthAtmosphere(), Small(4));
+    const BrunetonLut& lut = p.eval.lut;
+    for (double mu_s : {1.0, 0.5, 0.1}) {
+        const Vec3d point(0, 0, p.atm.bottom_radius);
+        const Vec3d sun = SunAt(mu_s);
+        Rgb table;
+        lut.SunAndSkyIrradiance(point, Vec3d(0, 0, 1), sun, &table);
+        Vec3d sum;
+        const int nt = 64, np = 128;
+        for (int i = 0; i < nt; ++i) {
+            const double theta = (i + 0.5) * (kPi / 2) / nt;
+            for (int j = 0; j < np; ++j) {
+                const double phi = (j + 0.5) * 2.0 * kPi / np;
+                const Vec3d dir(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                std::cos(theta));
+                const RayResult r = p.eval.Evaluate(point, dir, sun, false);
+                sum += Vec3d(r.sky) *
+                       (std::cos(theta) * std::sin(theta) * (kPi / 2 / nt) * (2.0 * kPi / np));
+            }
+        }
+        for (int c = 0; c < 3; ++c) {
+            const double e = Rel(static_cast<double>(table[c]), sum[c]);
+            std::printf("mu_s %.1f channel %d: table %.5g integral %.5g (%.1f %%)\n", mu_s, c,
+                        static_cast<double>(table[c]), sum[c], 100.0 * e);
+            EXPECT_LT(e, 0.08);
+            EXPECT_LT(static_cast<double>(table[c]), sum[c] * 1.01);  // misses order N
+        }
+    }
+}
+
 TEST(Bruneton, CombinedMieStorageAgreesWithSeparate) {
     BrunetonConfig c = Small(4);
     const Precomputed separate(EarthAtmosphere(), c);

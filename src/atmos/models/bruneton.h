@@ -31,7 +31,7 @@
 // grid of incident directions, but laid out around the sun's azimuth instead of
 // the view's (the incident radiance then depends on (r, mu_s) only and is
 // computed once per (r, mu_s) instead of once per texel: same quadrature order,
-// about 256x fewer table lookups); the view-ray samples of single and multiple
+// about 1000x fewer table lookups); the view-ray samples of single and multiple
 // scattering (transmittance, densities, mapping of r_i and mu_i) are computed
 // once per (r, mu) row and shared by the row's (mu_s, nu) texels. Both are exact
 // rearrangements except for the rotated direction grid. Tables are per unit

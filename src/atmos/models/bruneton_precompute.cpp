@@ -95,8 +95,9 @@ void ComputeSingleScatteringTables(const BrunetonLut& lut, Table* rayleigh, Tabl
         lut.RMuMuSNuFromTexel(0, y, z, &r, &mu, &mu_s, &nu, &ground);
         const int n = lut.cfg.scattering_samples;
         const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
-        double d_i[kMaxScatteringSamples + 1], r_i[kMaxScatteringSamples + 1];
-        Rgb t_r[kMaxScatteringSamples + 1], t_m[kMaxScatteringSamples + 1];
+        const size_t ns = static_cast<size_t>(n) + 1;
+        std::vector<double> d_i(ns), r_i(ns);
+        std::vector<Rgb> t_r(ns), t_m(ns);
         for (int i = 0; i <= n; ++i) {
             const double d = i * dx;
             d_i[i] = d;
@@ -401,7 +402,8 @@ struct FastScatteringLookup {
             }
         }
     }
-    // The (nu, mu_s) part: tex_x and lerp from u_nu as in Sample().
+    // The (nu, mu_s) part, with tex_x = floor(u_nu (NU - 1)) and lerp its fraction
+    // (BrunetonLut::Lookup4D).
     Rgb SampleRows(const Rows& rows, double tex_x, float lerp, double u_mu_s) const {
         int xa, xb;
         float fxa, fxb;
@@ -419,41 +421,6 @@ struct FastScatteringLookup {
                 acc[0] += w * p[0];
                 acc[1] += w * p[1];
                 acc[2] += w * p[2];
-            }
-        }
-        return Rgb(acc[0], acc[1], acc[2]);
-    }
-    Rgb Sample(double u_nu, double u_mu_s, double u_mu, double u_r) const {
-        const double tex_coord_x = u_nu * (nu_size - 1);
-        const double tex_x = std::floor(tex_coord_x);
-        const float lerp = static_cast<float>(tex_coord_x - tex_x);
-        int xa, xb, y0, z0;
-        float fxa, fxb, fy, fz;
-        TableView::Split((tex_x + u_mu_s) / nu_size, width, &xa, &fxa);
-        TableView::Split((tex_x + 1.0 + u_mu_s) / nu_size, width, &xb, &fxb);
-        TableView::Split(u_mu, height, &y0, &fy);
-        TableView::Split(u_r, depth, &z0, &fz);
-        const int x1a = Min(xa + 1, width - 1), x1b = Min(xb + 1, width - 1);
-        const int y1 = Min(y0 + 1, height - 1), z1 = Min(z0 + 1, depth - 1);
-        const int xs[4] = {xa, x1a, xb, x1b};
-        const float wx[4] = {(1.0f - fxa) * (1.0f - lerp), fxa * (1.0f - lerp), (1.0f - fxb) * lerp,
-                             fxb * lerp};
-        const int ys[2] = {y0, y1};
-        const float wy[2] = {1.0f - fy, fy};
-        const int zs[2] = {z0, z1};
-        const float wz[2] = {1.0f - fz, fz};
-        float acc[3] = {0.0f, 0.0f, 0.0f};
-        for (int k = 0; k < 2; ++k) {
-            for (int j = 0; j < 2; ++j) {
-                const float wzy = wz[k] * wy[j];
-                const float* row = data + (static_cast<size_t>(zs[k]) * height + ys[j]) * width * 3;
-                for (int i = 0; i < 4; ++i) {
-                    const float w = wzy * wx[i];
-                    const float* p = row + static_cast<size_t>(xs[i]) * 3;
-                    acc[0] += w * p[0];
-                    acc[1] += w * p[1];
-                    acc[2] += w * p[2];
-                }
             }
         }
         return Rgb(acc[0], acc[1], acc[2]);
@@ -476,10 +443,10 @@ void ComputeMultipleScatteringTable(const BrunetonLut& lut, const TableView& den
         lut.RMuMuSNuFromTexel(0, y, z, &r, &mu, &mu_s, &nu, &ground);
         const int n = lut.cfg.scattering_samples;
         const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
-        double d_i[kMaxScatteringSamples + 1], r_i[kMaxScatteringSamples + 1];
-        double u_mu[kMaxScatteringSamples + 1], u_r[kMaxScatteringSamples + 1];
-        Rgb t_i[kMaxScatteringSamples + 1];
-        FastScatteringLookup::Rows rows[kMaxScatteringSamples + 1];
+        const size_t ns = static_cast<size_t>(n) + 1;
+        std::vector<double> d_i(ns), r_i(ns), u_mu(ns), u_r(ns);
+        std::vector<Rgb> t_i(ns);
+        std::vector<FastScatteringLookup::Rows> rows(ns);
         for (int i = 0; i <= n; ++i) {
             const double d = i * dx;
             d_i[i] = d;
