@@ -263,13 +263,14 @@ TEST(Bruneton, OrdersDecreaseAndMultipleScatteringFraction) {
     const AtmosphereParameters atm = EarthAtmosphere();
     const BrunetonConfig cfg = Small(4);
     BrunetonTables tables;
-    PrecomputeBruneton(atm, cfg, &tables, nullptr, [&](int n, const BrunetonTables& t) {
-        BrunetonEvaluator e;
-        e.lut = MakeBrunetonLut(atm, cfg, t);
-        zenith[n] = Sky(e, 0.0, 1.0, 1.0);
-        noon[n] = Sky(e, 0.0, std::sqrt(0.5), std::sin(Radians(60.0)), kPi / 2);
-        twilight[n] = Sky(e, 0.0, 1.0, std::sin(Radians(-6.0)));
-    });
+    PrecomputeBruneton(atm, cfg, &tables, nullptr,
+                       [&](int n, const BrunetonTables& t, const Table*) {
+                           BrunetonEvaluator e;
+                           e.lut = MakeBrunetonLut(atm, cfg, t);
+                           zenith[n] = Sky(e, 0.0, 1.0, 1.0);
+                           noon[n] = Sky(e, 0.0, std::sqrt(0.5), std::sin(Radians(60.0)), kPi / 2);
+                           twilight[n] = Sky(e, 0.0, 1.0, std::sin(Radians(-6.0)));
+                       });
     Rgb prev_order;
     for (int n = 1; n <= 4; ++n) {
         const Rgb order = n == 1 ? zenith[1] : zenith[n] - zenith[n - 1];
@@ -422,6 +423,92 @@ TEST(Bruneton, SkyIrradianceMatchesHemisphereIntegralOfSkyRadiance) {
             EXPECT_LT(static_cast<double>(table[c]), sum[c] * 1.01);  // misses order N
         }
     }
+}
+
+// Seed 004 ComputeScatteringDensity for order 2, written as the seed has it (the
+// 16 x 32 direction grid around the view's azimuth, lookups per direction),
+// without ground albedo: the reference for the atmos rearrangement.
+Rgb SeedDensityOrder2(const BrunetonLut& lut, const TableView& rayleigh, const TableView& mie,
+                      double r, double mu, double mu_s, double nu) {
+    const AtmosphereParameters& atm = lut.atm;
+    const Vec3d omega(std::sqrt(1.0 - mu * mu), 0.0, mu);
+    const double sun_x = omega.x == 0.0 ? 0.0 : (nu - mu * mu_s) / omega.x;
+    const double sun_y = std::sqrt(std::max(1.0 - sun_x * sun_x - mu_s * mu_s, 0.0));
+    const Vec3d omega_s(sun_x, sun_y, mu_s);
+    const int n = 16;
+    const double dphi = kPi / n, dtheta = kPi / n;
+    Vec3d sum;
+    const double alt = r - atm.bottom_radius;
+    const double rho_r = GetProfileDensity(atm.rayleigh_density, alt);
+    const double rho_m = GetProfileDensity(atm.mie_density, alt);
+    for (int l = 0; l < n; ++l) {
+        const double theta = (l + 0.5) * dtheta;
+        const bool ground = RayIntersectsGround(r, std::cos(theta), atm.bottom_radius);
+        for (int m = 0; m < 2 * n; ++m) {
+            const double phi = (m + 0.5) * dphi;
+            const Vec3d wi(std::cos(phi) * std::sin(theta), std::sin(phi) * std::sin(theta),
+                           std::cos(theta));
+            const double domega = dtheta * dphi * std::sin(theta);
+            const double nu1 = Dot(omega_s, wi);
+            const Vec3d li = Vec3d(lut.GetScattering(rayleigh, r, wi.z, mu_s, nu1, ground).rgb()) *
+                                 RayleighPhase(nu1) +
+                             Vec3d(lut.GetScattering(mie, r, wi.z, mu_s, nu1, ground).rgb()) *
+                                 CornetteShanksPhase(atm.mie_phase_g, nu1);
+            const double nu2 = Dot(omega, wi);
+            sum += li *
+                   (atm.rayleigh_scattering * (rho_r * RayleighPhase(nu2)) +
+                    atm.mie_scattering * (rho_m * CornetteShanksPhase(atm.mie_phase_g, nu2))) *
+                   domega;
+        }
+    }
+    return Rgb(sum);
+}
+
+TEST(Bruneton, ScatteringDensityMatchesTheSeedsFormulation) {
+    // The density J_2 table (incident radiance per (r, mu_s), direction grid
+    // around the sun) against the seed's per-texel formulation at random texels.
+    const AtmosphereParameters atm = EarthAtmosphere();
+    const BrunetonConfig cfg = Small(2);
+    BrunetonTables tables;
+    double sum_rel = 0.0, max_rel = 0.0;
+    int count = 0;
+    PrecomputeBruneton(
+        atm, cfg, &tables, nullptr, [&](int order, const BrunetonTables& t, const Table* density) {
+            static BrunetonTables single;
+            if (order == 1) {
+                single = t;  // scattering = single Rayleigh, single_mie = single Mie
+                return;
+            }
+            BrunetonLut lut = MakeBrunetonLut(atm, cfg, single);
+            std::mt19937 rng(7);
+            const int w = density->width(), h = density->height(), d = density->depth();
+            for (int i = 0; i < 150; ++i) {
+                const int x = static_cast<int>(rng() % static_cast<unsigned>(w));
+                const int y = static_cast<int>(rng() % static_cast<unsigned>(h));
+                const int z = static_cast<int>(rng() % static_cast<unsigned>(d));
+                double r, mu, mu_s, nu;
+                bool ground;
+                lut.RMuMuSNuFromTexel(x, y, z, &r, &mu, &mu_s, &nu, &ground);
+                if (mu_s < 0.0) continue;  // dark texels: relative error meaningless
+                const Rgb want = SeedDensityOrder2(lut, single.scattering.view(),
+                                                   single.single_mie.view(), r, mu, mu_s, nu);
+                const Vec4f got = density->view().Fetch(x, y, z);
+                const double got_c[2] = {static_cast<double>(got.x), static_cast<double>(got.z)};
+                for (int c = 0; c < 2; ++c) {
+                    const double e = Rel(got_c[c], static_cast<double>(want[2 * c]));
+                    sum_rel += e;
+                    max_rel = std::max(max_rel, e);
+                    ++count;
+                }
+            }
+        });
+    std::printf(
+        "J_2 (red, blue) against the seed's formulation: mean relative difference %.2g, "
+        "max %.2g over %d values\n",
+        sum_rel / count, max_rel, count);
+    EXPECT_GT(count, 100);
+    EXPECT_LT(sum_rel / count, 0.005);
+    EXPECT_LT(max_rel, 0.02);
 }
 
 TEST(Bruneton, CombinedMieStorageAgreesWithSeparate) {

@@ -490,8 +490,10 @@ struct BrunetonTimings {
     BrunetonStageTimes cpu;   // process CPU time (all threads: std::clock)
 };
 
-// Called with the tables as they stand after each scattering order (1..N).
-using BrunetonOrderCallback = std::function<void(int order, const BrunetonTables& tables)>;
+// Called with the tables as they stand after each scattering order (1..N), and
+// that order's scattering density J_n (nullptr for order 1): for tests.
+using BrunetonOrderCallback =
+    std::function<void(int order, const BrunetonTables& tables, const Table* density)>;
 
 // The whole precomputation of seed 004 on the CPU (ParallelFor). Tables are per
 // unit solar irradiance. Throws atmos::Error for an invalid configuration.

@@ -565,7 +565,7 @@ void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonCo
         }
     }
     stage.AddTo(&t, &BrunetonStageTimes::single_scattering);
-    if (on_order) on_order(1, *tables);
+    if (on_order) on_order(1, *tables, nullptr);
 
     Table delta_multiple, delta_density;
     for (int order = 2; order <= config.orders; ++order) {
@@ -603,7 +603,7 @@ void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonCo
             }
         });
         stage.AddTo(&t, &BrunetonStageTimes::multiple_scattering);
-        if (on_order) on_order(order, *tables);
+        if (on_order) on_order(order, *tables, &delta_density);
     }
     start.AddTo(&t, &BrunetonStageTimes::total);
     if (timings) *timings = t;
