@@ -384,6 +384,12 @@ TEST(Bruneton, GroundIsLitOnlyWithAlbedo) {
         std::printf("ground channel %d: sky light adds %.1f %%\n", c,
                     100.0 * (static_cast<double>(b.ground[c]) / direct - 1.0));
     }
+    // A camera on the ground looking down sees a lit ground at its feet.
+    const RayResult feet =
+        grey.eval.Evaluate(Vec3d(0, 0, atm.bottom_radius), Dir(-0.3), SunAt(0.7), true);
+    EXPECT_TRUE(feet.hits_ground);
+    EXPECT_GT(feet.ground.y, 0.0f);
+    EXPECT_EQ(feet.sky.y, 0.0f);
     // Higher orders see the ground: a bright ground brightens the sky.
     const Rgb sky_black = Sky(black.eval, 0.0, 0.5, 0.7);
     const Rgb sky_grey = Sky(grey.eval, 0.0, 0.5, 0.7);

@@ -448,13 +448,17 @@ struct BrunetonEvaluator {
         const AtmosphereSegment seg =
             ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
         out.hits_ground = seg.hits_ground;
-        if (!seg.inside) return out;  // misses the atmosphere: L = 0, T = 1
+        if (!seg.inside && !seg.hits_ground) return out;  // misses the atmosphere: L = 0, T = 1
         if (!seg.hits_ground) {
             out.sky = lut.SkyRadiance(camera, dir, 0.0, sun, false, &out.transmittance);
             return out;
         }
-        const Vec3d ground = camera + dir * seg.t_end;
-        out.sky = lut.SkyRadianceToPoint(camera, ground, 0.0, sun, true, &out.transmittance);
+        // A camera on the ground looking down sees the ground at its feet (zero
+        // length: no scattering, T = 1).
+        const Vec3d ground = seg.inside ? camera + dir * seg.t_end : camera;
+        if (seg.inside) {
+            out.sky = lut.SkyRadianceToPoint(camera, ground, 0.0, sun, true, &out.transmittance);
+        }
         if (want_ground && MaxComponent(atm.ground_albedo) > 0.0) {
             const Vec3d normal = Normalize(ground);
             Rgb sky_irradiance;
