@@ -473,11 +473,17 @@ void ComputeMultipleScatteringTable(const BrunetonLut& lut, const TableView& den
             tex_x[k] = std::floor(tex_coord_x);
             lerp[k] = static_cast<float>(tex_coord_x - tex_x[k]);
         }
+        std::vector<double> u_mu_s(mu_s_x.size());
         for (int i = 0; i <= n; ++i) {
             const double inv_r_i = 1.0 / r_i[i];
+            // First the mu_s coordinates of all texels (a vectorisable loop)...
             for (size_t k = 0; k < sum.size(); ++k) {
                 const double mu_s_i = ClampCosine((r * mu_s_x[k] + d_i[i] * nu_x[k]) * inv_r_i);
-                sum[k] += fast.SampleRows(rows[i], tex_x[k], lerp[k], fast.UMuS(mu_s_i)) * t_i[i];
+                u_mu_s[k] = fast.UMuS(mu_s_i);
+            }
+            // ...then the lookups.
+            for (size_t k = 0; k < sum.size(); ++k) {
+                sum[k] += fast.SampleRows(rows[i], tex_x[k], lerp[k], u_mu_s[k]) * t_i[i];
             }
         }
         for (int x = 0; x < width; ++x) out->Set(x, y, z, ToVec4(sum[static_cast<size_t>(x)]));
