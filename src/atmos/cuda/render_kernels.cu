@@ -4,6 +4,7 @@
 // the models' evaluators); built for the architectures of ATMOS_CUDA_ARCHITECTURES.
 #include <cuda_runtime.h>
 
+#include "models/bruneton.h"
 #include "models/empty.h"
 #include "models/flat.h"
 #include "models/hillaire.h"
@@ -79,6 +80,8 @@ template cudaError_t LaunchRender<TransmittanceEvaluator<OneilOptics>>(
 template cudaError_t LaunchRender<TransmittanceEvaluator<PolynomialTransmittanceOptics>>(
     const TransmittanceEvaluator<PolynomialTransmittanceOptics>&, const PixelSetup&, float*,
     cudaStream_t);
+template cudaError_t LaunchRender<BrunetonEvaluator>(const BrunetonEvaluator&, const PixelSetup&,
+                                                     float*, cudaStream_t);
 
 }  // namespace cuda
 }  // namespace atmos

@@ -6,6 +6,7 @@
 
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "models/bruneton.h"
 #include "models/empty.h"
 #include "models/flat.h"
 #include "models/hillaire.h"
@@ -54,6 +55,7 @@ const std::vector<Entry>& Registry() {
         MakeEntry<TransmittanceOneilModel>(),
         MakeEntry<TransmittancePolynomialModel>(),
         MakeEntry<HillaireModel>(),
+        MakeEntry<BrunetonModel>(),
     };
     return entries;
 }

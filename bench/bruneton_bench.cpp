@@ -1,0 +1,113 @@
+// atmos benchmarks of model `bruneton`: precomputation time per stage, and the
+// per-call cost of rendering from the tables.
+//
+// Run: build/bench/atmos_bench --benchmark_filter=Bruneton
+// BM_BrunetonPrecompute/ORDERS/THREADS reports the stages (seconds, wall clock)
+// as counters.
+#include <benchmark/benchmark.h>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "atmos/atmosphere.h"
+#include "atmos/view.h"
+#include "base/parallel.h"
+#include "models/bruneton.h"
+#include "render/render.h"
+
+namespace atmos {
+namespace {
+
+void BM_BrunetonPrecompute(benchmark::State& state) {
+    BrunetonConfig config;
+    config.orders = static_cast<int>(state.range(0));
+    ThreadLimit limit(static_cast<int>(state.range(1)));
+    const AtmosphereParameters atm = EarthAtmosphere();
+    BrunetonTimings t;
+    for (auto _ : state) {
+        BrunetonTables tables;
+        PrecomputeBruneton(atm, config, &tables, &t);
+        benchmark::DoNotOptimize(tables.scattering.data());
+    }
+    // Wall clock, and CPU time of all threads (the machine may be shared).
+    for (const auto& [prefix, s] :
+         {std::make_pair("wall_", t.wall), std::make_pair("cpu_", t.cpu)}) {
+        const std::string p = prefix;
+        state.counters[p + "transmittance"] = s.transmittance;
+        state.counters[p + "direct_irr"] = s.direct_irradiance;
+        state.counters[p + "single"] = s.single_scattering;
+        state.counters[p + "density"] = s.scattering_density;
+        state.counters[p + "indirect_irr"] = s.indirect_irradiance;
+        state.counters[p + "multiple"] = s.multiple_scattering;
+        state.counters[p + "total"] = s.total;
+    }
+}
+// Args: orders, threads (0: all cores).
+BENCHMARK(BM_BrunetonPrecompute)
+    ->Args({4, 2})
+    ->Args({4, 1})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+struct Prepared {
+    BrunetonTables tables;
+    BrunetonEvaluator evaluator;
+    Prepared() {
+        const AtmosphereParameters atm = EarthAtmosphere();
+        BrunetonConfig config;
+        PrecomputeBruneton(atm, config, &tables);
+        evaluator.lut = MakeBrunetonLut(atm, config, tables);
+    }
+};
+const Prepared& GetPrepared() {
+    static const Prepared p;
+    return p;
+}
+
+void RunView(benchmark::State& state, const char* view_name) {
+    const BrunetonEvaluator& e = GetPrepared().evaluator;
+    const View view = GetView(view_name, EarthAtmosphere());
+    std::vector<Vec3d> dirs;
+    for (int i = 0; i < 64 * 36; ++i) {
+        dirs.push_back(view.camera.RayDirection(i % 64, (i / 64) % 36, 64, 36));
+    }
+    size_t i = 0;
+    for (auto _ : state) {
+        RayResult r = e.Evaluate(view.camera.position, dirs[i], view.sun_direction, true);
+        benchmark::DoNotOptimize(r);
+        i = (i + 1) % dirs.size();
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+
+void BM_BrunetonEvaluateGroundSunrise(benchmark::State& state) { RunView(state, "ground-sunrise"); }
+BENCHMARK(BM_BrunetonEvaluateGroundSunrise);
+
+void BM_BrunetonEvaluatePlaneNoon(benchmark::State& state) { RunView(state, "plane-noon"); }
+BENCHMARK(BM_BrunetonEvaluatePlaneNoon);
+
+void BM_BrunetonEvaluateSpace(benchmark::State& state) { RunView(state, "space"); }
+BENCHMARK(BM_BrunetonEvaluateSpace);
+
+// A whole 1920x1080 image through the render loop (all threads).
+void BM_BrunetonRender1080p(benchmark::State& state) {
+    const BrunetonEvaluator& e = GetPrepared().evaluator;
+    RenderRequest request;
+    request.view = GetView("ground-sunrise", EarthAtmosphere());
+    request.width = 1920;
+    request.height = 1080;
+    request.show_progress = false;
+    const PixelSetup setup = MakePixelSetup(request, EarthAtmosphere());
+    Image image;
+    image.Resize(1920, 1080);
+    for (auto _ : state) {
+        RenderImage(e, setup, image.View(), false);
+        benchmark::ClobberMemory();
+    }
+}
+BENCHMARK(BM_BrunetonRender1080p)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace atmos

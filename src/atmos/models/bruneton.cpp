@@ -1,0 +1,257 @@
+// atmos model `bruneton`: options, Prepare, and the bake (EXR tables + JSON).
+#include "models/bruneton.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "atmos/error.h"
+#include "io/table_io.h"
+
+namespace atmos {
+
+namespace {
+
+constexpr const char* kBakeJson = "bruneton.json";
+constexpr int kBakeFormatVersion = 1;
+
+ModelOptionSpec IntOption(const char* name, int def, const char* help, int lo, int hi) {
+    return {
+        name, ModelOptionSpec::Type::kInteger, std::to_string(def), help, double(lo), double(hi),
+        {}};
+}
+
+}  // namespace
+
+ModelInfo BrunetonModel::StaticInfo() {
+    ModelInfo info;
+    info.name = "bruneton";
+    info.title = "Precomputed atmospheric scattering (Bruneton & Neyret 2008, Bruneton 2017)";
+    info.citation =
+        "Bruneton & Neyret 2008; Bruneton 2017 (seed 004, functions.glsl); seed 003 sections "
+        "5.2, 11.2.3";
+    info.summary =
+        "4D scattering tables (packed 3D), transmittance and irradiance tables, N orders";
+    info.capabilities.multiple_scattering = true;
+    info.capabilities.precomputed = true;
+    const BrunetonConfig d;
+    info.options = {
+        IntOption("orders", d.orders, "scattering orders (1 = single scattering)", 1, 32),
+        IntOption("scattering-samples", d.scattering_samples,
+                  "trapezoid intervals along view rays in single and multiple scattering", 1, 1000),
+        {"mie-storage",
+         ModelOptionSpec::Type::kChoice,
+         "separate",
+         "single Mie scattering in its own table, or combined (red in the scattering table's "
+         "alpha, green and blue extrapolated)",
+         0,
+         0,
+         {"separate", "combined"}},
+        IntOption("transmittance-width", d.transmittance_width, "transmittance table: mu texels", 2,
+                  4096),
+        IntOption("transmittance-height", d.transmittance_height, "transmittance table: r texels",
+                  2, 4096),
+        IntOption("irradiance-width", d.irradiance_width, "irradiance table: mu_s texels", 2, 4096),
+        IntOption("irradiance-height", d.irradiance_height, "irradiance table: r texels", 2, 4096),
+        IntOption("scattering-r", d.scattering_r, "scattering table: r texels", 2, 1024),
+        IntOption("scattering-mu", d.scattering_mu, "scattering table: mu texels (even)", 4, 4096),
+        IntOption("scattering-mu-s", d.scattering_mu_s, "scattering table: mu_s texels", 2, 1024),
+        IntOption("scattering-nu", d.scattering_nu, "scattering table: nu texels", 2, 1024),
+    };
+    return info;
+}
+
+BrunetonModel::BrunetonModel(const ModelOptions& options)
+    : info_(StaticInfo()), atm_(EarthAtmosphere()) {
+    config_.orders = options.GetInt("orders");
+    config_.scattering_samples = options.GetInt("scattering-samples");
+    config_.combined_mie = options.GetText("mie-storage") == "combined";
+    config_.transmittance_width = options.GetInt("transmittance-width");
+    config_.transmittance_height = options.GetInt("transmittance-height");
+    config_.irradiance_width = options.GetInt("irradiance-width");
+    config_.irradiance_height = options.GetInt("irradiance-height");
+    config_.scattering_r = options.GetInt("scattering-r");
+    config_.scattering_mu = options.GetInt("scattering-mu");
+    config_.scattering_mu_s = options.GetInt("scattering-mu-s");
+    config_.scattering_nu = options.GetInt("scattering-nu");
+    ValidateBrunetonConfig(config_);
+}
+
+void BrunetonModel::Prepare(const AtmosphereParameters& atmosphere) {
+    atm_ = atmosphere;
+    PrecomputeBruneton(atm_, config_, &tables_, &timings_);
+    prepared_ = true;
+}
+
+BrunetonEvaluator BrunetonModel::MakeEvaluator() const {
+    if (!prepared_) Fail("model bruneton: Prepare() or LoadBaked() must run before rendering");
+    BrunetonEvaluator e;
+    e.lut = MakeBrunetonLut(atm_, config_, tables_);
+    return e;
+}
+
+namespace {
+
+nlohmann::ordered_json ConfigJson(const BrunetonConfig& c) {
+    nlohmann::ordered_json j;
+    j["orders"] = c.orders;
+    j["scattering_samples"] = c.scattering_samples;
+    j["mie_storage"] = c.combined_mie ? "combined" : "separate";
+    j["transmittance_width"] = c.transmittance_width;
+    j["transmittance_height"] = c.transmittance_height;
+    j["irradiance_width"] = c.irradiance_width;
+    j["irradiance_height"] = c.irradiance_height;
+    j["scattering_r_size"] = c.scattering_r;
+    j["scattering_mu_size"] = c.scattering_mu;
+    j["scattering_mu_s_size"] = c.scattering_mu_s;
+    j["scattering_nu_size"] = c.scattering_nu;
+    return j;
+}
+
+std::string ReadText(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) Fail("cannot read '", path, "'");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+}  // namespace
+
+void BrunetonModel::Bake(const std::string& directory) const {
+    if (!prepared_) Fail("model bruneton: nothing to bake (Prepare() has not run)");
+    namespace fs = std::filesystem;
+    const fs::path dir(directory);
+    WriteTableExr(tables_.transmittance, (dir / "transmittance.exr").string());
+    WriteTableExr(tables_.irradiance, (dir / "irradiance.exr").string());
+    WriteTableExr(tables_.scattering, (dir / "scattering.exr").string());
+    if (!config_.combined_mie) {
+        WriteTableExr(tables_.single_mie, (dir / "single_mie_scattering.exr").string());
+    }
+    const double h =
+        std::sqrt(atm_.top_radius * atm_.top_radius - atm_.bottom_radius * atm_.bottom_radius);
+    nlohmann::ordered_json j;
+    j["model"] = "bruneton";
+    j["format_version"] = kBakeFormatVersion;
+    j["description"] =
+        "Bruneton 2017 precomputed atmospheric scattering tables (seed 004 mappings), float32, "
+        "per unit solar irradiance (multiply radiance and irradiance by solar_irradiance). Each "
+        "table is one EXR of W*D x H pixels: the D layers side by side.";
+    j["options"] = ConfigJson(config_);
+    nlohmann::ordered_json tables;
+    tables["transmittance"] = {
+        {"file", "transmittance.exr"},
+        {"size", {config_.transmittance_width, config_.transmittance_height}},
+        {"channels", "RGB"},
+        {"mapping",
+         "u = coord(x_mu, W), x_mu = (d - (r_top - r)) / (rho + H - (r_top - r)), d = distance to "
+         "top; v = coord(rho / H, H_tex)"}};
+    tables["irradiance"] = {
+        {"file", "irradiance.exr"},
+        {"size", {config_.irradiance_width, config_.irradiance_height}},
+        {"channels", "RGB"},
+        {"content", "indirect irradiance on a horizontal surface (direct: from transmittance)"},
+        {"mapping",
+         "u = coord(mu_s / 2 + 1 / 2, W), v = coord((r - r_bottom) / (r_top - "
+         "r_bottom), H)"}};
+    tables["scattering"] = {
+        {"file", "scattering.exr"},
+        {"size",
+         {config_.scattering_nu * config_.scattering_mu_s, config_.scattering_mu,
+          config_.scattering_r}},
+        {"layout", "x = nu_index * MU_S + mu_s_index, y = mu, layer = r"},
+        {"channels", config_.combined_mie ? "RGBA" : "RGB"},
+        {"content", config_.combined_mie
+                        ? "RGB: single Rayleigh + multiple scattering / RayleighPhase(nu); A: "
+                          "single Mie red"
+                        : "single Rayleigh + multiple scattering / RayleighPhase(nu)"},
+        {"mapping", "seed 004 GetScatteringTextureUvwzFromRMuMuSNu"}};
+    if (!config_.combined_mie) {
+        tables["single_mie_scattering"] = {{"file", "single_mie_scattering.exr"},
+                                           {"size",
+                                            {config_.scattering_nu * config_.scattering_mu_s,
+                                             config_.scattering_mu, config_.scattering_r}},
+                                           {"channels", "RGB"},
+                                           {"mapping", "as scattering"}};
+    }
+    j["tables"] = tables;
+    j["constants"] = {{"bottom_radius", atm_.bottom_radius},
+                      {"top_radius", atm_.top_radius},
+                      {"H", h},
+                      {"mu_s_min", atm_.mu_s_min},
+                      {"texel_centre_mapping", "coord(x, n) = 0.5 / n + x (1 - 1 / n)"}};
+    j["atmosphere"] = nlohmann::ordered_json::parse(AtmosphereToJson(atm_));
+    const std::string path = (dir / kBakeJson).string();
+    std::ofstream out(path);
+    if (!out) Fail("cannot write '", path, "'");
+    out << j.dump(2) << "\n";
+    if (!out) Fail("cannot write '", path, "'");
+}
+
+void BrunetonModel::LoadBaked(const std::string& directory,
+                              const AtmosphereParameters& atmosphere) {
+    namespace fs = std::filesystem;
+    const fs::path dir(directory);
+    const std::string path = (dir / kBakeJson).string();
+    nlohmann::ordered_json j;
+    try {
+        j = nlohmann::ordered_json::parse(ReadText(path));
+    } catch (const nlohmann::json::exception& e) {
+        Fail("'", path, "' is not valid JSON: ", e.what());
+    }
+    try {
+        if (j.at("model").get<std::string>() != "bruneton") {
+            Fail("'", path, "' holds tables of model '", j.at("model").get<std::string>(),
+                 "', not bruneton");
+        }
+        if (j.at("format_version").get<int>() != kBakeFormatVersion) {
+            Fail("'", path, "' has format_version ", j.at("format_version").get<int>(),
+                 ", expected ", kBakeFormatVersion);
+        }
+        const nlohmann::ordered_json want = ConfigJson(config_);
+        const nlohmann::ordered_json& have = j.at("options");
+        for (auto it = want.begin(); it != want.end(); ++it) {
+            if (!have.contains(it.key()) || have.at(it.key()) != it.value()) {
+                Fail("'", path, "' was baked with ", it.key(), " = ",
+                     have.contains(it.key()) ? have.at(it.key()).dump() : "(missing)",
+                     ", but the model has ", it.value().dump());
+            }
+        }
+        const AtmosphereParameters baked =
+            AtmosphereFromJson(j.at("atmosphere").dump(), path + ": atmosphere");
+        if (AtmosphereToJson(baked) != AtmosphereToJson(atmosphere)) {
+            Fail("'", path,
+                 "' was baked for another atmosphere (its \"atmosphere\" differs from the one "
+                 "requested)");
+        }
+    } catch (const nlohmann::json::exception& e) {
+        Fail("'", path, "' is missing a field or has a wrong type: ", e.what());
+    }
+    BrunetonTables t;
+    auto read = [&](const char* name, int depth, int channels, int w, int h) {
+        Table table = ReadTableExr((dir / name).string(), depth, channels);
+        if (table.width() != w || table.height() != h) {
+            Fail("table '", (dir / name).string(), "' is ", table.width(), "x", table.height(),
+                 ", expected ", w, "x", h);
+        }
+        return table;
+    };
+    const BrunetonConfig& c = config_;
+    t.transmittance =
+        read("transmittance.exr", 1, 3, c.transmittance_width, c.transmittance_height);
+    t.irradiance = read("irradiance.exr", 1, 3, c.irradiance_width, c.irradiance_height);
+    t.scattering = read("scattering.exr", c.scattering_r, c.combined_mie ? 4 : 3,
+                        c.scattering_nu * c.scattering_mu_s, c.scattering_mu);
+    if (!c.combined_mie) {
+        t.single_mie = read("single_mie_scattering.exr", c.scattering_r, 3,
+                            c.scattering_nu * c.scattering_mu_s, c.scattering_mu);
+    }
+    tables_ = std::move(t);
+    atm_ = atmosphere;
+    timings_ = BrunetonTimings();
+    prepared_ = true;
+}
+
+}  // namespace atmos

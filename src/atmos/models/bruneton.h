@@ -1,0 +1,541 @@
+// atmos model `bruneton`: precomputed atmospheric scattering (Bruneton & Neyret
+// 2008, in the 2017 reimplementation documented by seed 004).
+//
+// Source: seed 004 (Bruneton 2017, functions.glsl: every section), seed 003
+// sections 5.2 and 11.2.3 (the thesis used this implementation with 4 orders).
+//
+// Implements (seed 004 section named in each function's comment):
+//   * transmittance to the top of the atmosphere T(r, mu) in a 2D table (256x64)
+//     with the generic (r, mu) mapping and texel-centre coordinates;
+//   * direct ground irradiance (64x16) and, per order, indirect irradiance;
+//   * single Rayleigh and Mie scattering in a 4D (r, mu, mu_s, nu) table packed
+//     in 3D (NU * MU_S, MU, R) = (8 * 32, 128, 32), mu split at the horizon;
+//   * scattering density J_n and multiple scattering orders 2..N (default 4),
+//     with the ground albedo in the higher orders;
+//   * rendering: GetSkyRadiance (viewer in space moved to the top; rays that miss
+//     the atmosphere: L = 0, T = 1), GetSkyRadianceToPoint (aerial perspective),
+//     GetSunAndSkyIrradiance (lit ground); light shafts via shadow_length.
+//   Mie storage: its own table (default) or combined (red in the alpha channel of
+//   the scattering table, green and blue extrapolated, seed 004
+//   GetExtrapolatedSingleMieScattering).
+//
+// Output: radiance per unit solar irradiance (1/sr): the tables are computed
+// with solar irradiance 1 (the render loop multiplies by the atmosphere's), and
+// the view ray's transmittance. Tables are float32 (GPU texture semantics,
+// base/texture.h); geometry and mappings are double.
+//
+// Valid: any camera (ground, air, space), sun down to mu_s_min (the table's
+// lower bound; below it the sky is taken as at mu_s_min, which is dark).
+//
+// Deviations: the scattering density integral uses the seed's 16 x 32 midpoint
+// grid of incident directions, but laid out around the sun's azimuth instead of
+// the view's (the incident radiance then depends on (r, mu_s) only and is
+// computed once per (r, mu_s) instead of once per texel: same quadrature order,
+// about 1000x fewer table lookups); the view-ray samples of single and multiple
+// scattering (transmittance, densities, mapping of r_i and mu_i) are computed
+// once per (r, mu) row and shared by the row's (mu_s, nu) texels. Both are exact
+// rearrangements except for the rotated direction grid. Tables are per unit
+// solar irradiance. The horizon handling: see docs/models.md ("bruneton:
+// horizon").
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "atmos/atmosphere.h"
+#include "atmos/model.h"
+#include "base/texture.h"
+#include "physics/density.h"
+#include "physics/geometry.h"
+#include "physics/phase.h"
+#include "render/render.h"
+
+namespace atmos {
+
+// Table sizes and precomputation options (defaults: seed 004).
+struct BrunetonConfig {
+    int transmittance_width = 256;  // mu
+    int transmittance_height = 64;  // r
+    int irradiance_width = 64;      // mu_s
+    int irradiance_height = 16;     // r
+    int scattering_r = 32;
+    int scattering_mu = 128;  // even: half for rays hitting the ground
+    int scattering_mu_s = 32;
+    int scattering_nu = 8;
+    int orders = 4;               // scattering orders (1 = single scattering only)
+    int scattering_samples = 50;  // trapezoid intervals along view rays (seed 004: 50)
+    bool combined_mie = false;    // Mie red in the scattering table's alpha
+};
+
+// The lookup functions of seed 004 over a set of tables (trivially copyable;
+// used both by the precomputation, over its intermediate tables, and by the
+// renderer, over the final ones). Every function is ATMOS_HD.
+struct BrunetonLut {
+    AtmosphereParameters atm;
+    BrunetonConfig cfg;
+    TableView transmittance_table;  // 3 channels
+    TableView irradiance_table;     // 3 channels (indirect only, as the seed)
+    TableView scattering_table;     // 3 channels (separate) or 4 (combined)
+    TableView single_mie_table;     // 3 channels, separate storage only
+
+    // ---- helpers (seed 004, "ClampRadius", distances) ----
+    ATMOS_HD double ClampRadius(double r) const {
+        return Clamp(r, atm.bottom_radius, atm.top_radius);
+    }
+    // Distance to the top boundary for a horizontal ray at ground level.
+    ATMOS_HD double HorizonH() const {
+        return Sqrt(atm.top_radius * atm.top_radius - atm.bottom_radius * atm.bottom_radius);
+    }
+    // Seed 004 "DistanceToNearestAtmosphereBoundary".
+    ATMOS_HD double DistanceToNearestAtmosphereBoundary(double r, double mu,
+                                                        bool ray_r_mu_intersects_ground) const {
+        return ray_r_mu_intersects_ground
+                   ? DistanceToBottomAtmosphereBoundary(r, mu, atm.bottom_radius)
+                   : DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius);
+    }
+
+    // ---- transmittance (seed 004, "Precomputation" / "Lookup" of transmittance) ----
+    // GetTransmittanceTextureUvFromRMu.
+    ATMOS_HD void TransmittanceUvFromRMu(double r, double mu, double* u, double* v) const {
+        const double H = HorizonH();
+        const double rho = SafeSqrt(r * r - atm.bottom_radius * atm.bottom_radius);
+        const double d = DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius);
+        const double d_min = atm.top_radius - r;
+        const double d_max = rho + H;
+        const double x_mu = (d - d_min) / (d_max - d_min);
+        const double x_r = rho / H;
+        *u = GetTextureCoordFromUnitRange(x_mu, cfg.transmittance_width);
+        *v = GetTextureCoordFromUnitRange(x_r, cfg.transmittance_height);
+    }
+    // GetRMuFromTransmittanceTextureUv (the inverse).
+    ATMOS_HD void RMuFromTransmittanceUv(double u, double v, double* r, double* mu) const {
+        const double x_mu = GetUnitRangeFromTextureCoord(u, cfg.transmittance_width);
+        const double x_r = GetUnitRangeFromTextureCoord(v, cfg.transmittance_height);
+        const double H = HorizonH();
+        const double rho = H * x_r;
+        *r = Sqrt(rho * rho + atm.bottom_radius * atm.bottom_radius);
+        const double d_min = atm.top_radius - *r;
+        const double d_max = rho + H;
+        const double d = d_min + x_mu * (d_max - d_min);
+        const double m = d == 0.0 ? 1.0 : (H * H - rho * rho - d * d) / (2.0 * *r * d);
+        *mu = ClampCosine(m);
+    }
+    // GetTransmittanceToTopAtmosphereBoundary: one lookup.
+    ATMOS_HD Rgb TransmittanceToTop(double r, double mu) const {
+        double u, v;
+        TransmittanceUvFromRMu(ClampRadius(r), ClampCosine(mu), &u, &v);
+        return transmittance_table.SampleBilinear(u, v).rgb();
+    }
+    // GetTransmittance between (r, mu) and the point at distance d along the ray;
+    // the caller says whether the ray (r, mu) hits the ground (seed 004: not
+    // recomputed here, because rounding makes that test unreliable at the horizon).
+    ATMOS_HD Rgb Transmittance(double r, double mu, double d,
+                               bool ray_r_mu_intersects_ground) const {
+        const double r_d = ClampRadius(Sqrt(d * d + 2.0 * r * mu * d + r * r));
+        const double mu_d = ClampCosine((r * mu + d) / r_d);
+        Rgb t;
+        if (ray_r_mu_intersects_ground) {
+            t = TransmittanceToTop(r_d, -mu_d) / TransmittanceToTop(r, -mu);
+        } else {
+            t = TransmittanceToTop(r, mu) / TransmittanceToTop(r_d, mu_d);
+        }
+        return SafeRatio(t);
+    }
+    // GetTransmittanceToSun: the visible fraction of the sun's disc above the
+    // horizon as a smoothstep (seed 004, "Transmittance to the Sun").
+    ATMOS_HD Rgb TransmittanceToSun(double r, double mu_s) const {
+        const double sin_theta_h = atm.bottom_radius / r;
+        const double cos_theta_h = -SafeSqrt(1.0 - sin_theta_h * sin_theta_h);
+        const double a = sin_theta_h * atm.sun_angular_radius;
+        const double f = SmoothStep(-a, a, mu_s - cos_theta_h);
+        if (f <= 0.0) return Rgb(0.0f);
+        return TransmittanceToTop(r, mu_s) * static_cast<float>(f);
+    }
+
+    // ---- scattering table mapping (seed 004, "Precomputation" of single scattering) ----
+    // The mu_s part of GetScatteringTextureUvwzFromRMuMuSNu.
+    ATMOS_HD double ScatteringUMuS(double mu_s) const {
+        const double H = HorizonH();
+        const double d = DistanceToTopAtmosphereBoundary(atm.bottom_radius, mu_s, atm.top_radius);
+        const double d_min = atm.top_radius - atm.bottom_radius;
+        const double d_max = H;
+        const double a = (d - d_min) / (d_max - d_min);
+        const double D =
+            DistanceToTopAtmosphereBoundary(atm.bottom_radius, atm.mu_s_min, atm.top_radius);
+        const double A = (D - d_min) / (d_max - d_min);
+        return GetTextureCoordFromUnitRange(Max(1.0 - a / A, 0.0) / (1.0 + a), cfg.scattering_mu_s);
+    }
+    // The (mu, r) part: v = u_mu, w = u_r.
+    ATMOS_HD void ScatteringUMuR(double r, double mu, bool ray_r_mu_intersects_ground, double* u_mu,
+                                 double* u_r) const {
+        const double H = HorizonH();
+        const double rho = SafeSqrt(r * r - atm.bottom_radius * atm.bottom_radius);
+        *u_r = GetTextureCoordFromUnitRange(rho / H, cfg.scattering_r);
+        const double r_mu = r * mu;
+        const double discriminant = r_mu * r_mu - r * r + atm.bottom_radius * atm.bottom_radius;
+        const int half = cfg.scattering_mu / 2;
+        if (ray_r_mu_intersects_ground) {
+            // Distance to the ground, between r - bottom (mu = -1) and rho (horizon).
+            const double d = -r_mu - SafeSqrt(discriminant);
+            const double d_min = r - atm.bottom_radius;
+            const double d_max = rho;
+            const double x = d_max == d_min ? 0.0 : (d - d_min) / (d_max - d_min);
+            *u_mu = 0.5 - 0.5 * GetTextureCoordFromUnitRange(x, half);
+        } else {
+            // Distance to the top, between top - r (mu = 1) and rho + H (horizon).
+            const double d = -r_mu + SafeSqrt(discriminant + H * H);
+            const double d_min = atm.top_radius - r;
+            const double d_max = rho + H;
+            *u_mu = 0.5 + 0.5 * GetTextureCoordFromUnitRange((d - d_min) / (d_max - d_min), half);
+        }
+    }
+    // GetScatteringTextureUvwzFromRMuMuSNu: (u_nu, u_mu_s, u_mu, u_r).
+    ATMOS_HD void ScatteringUvwz(double r, double mu, double mu_s, double nu,
+                                 bool ray_r_mu_intersects_ground, double uvwz[4]) const {
+        ScatteringUMuR(r, mu, ray_r_mu_intersects_ground, &uvwz[2], &uvwz[3]);
+        uvwz[1] = ScatteringUMuS(mu_s);
+        uvwz[0] = (nu + 1.0) / 2.0;
+    }
+    // GetRMuMuSNuFromScatteringTextureUvwz (the inverse).
+    ATMOS_HD void RMuMuSNuFromScatteringUvwz(const double uvwz[4], double* r, double* mu,
+                                             double* mu_s, double* nu,
+                                             bool* ray_r_mu_intersects_ground) const {
+        const double H = HorizonH();
+        const double rho = H * GetUnitRangeFromTextureCoord(uvwz[3], cfg.scattering_r);
+        *r = Sqrt(rho * rho + atm.bottom_radius * atm.bottom_radius);
+        const int half = cfg.scattering_mu / 2;
+        if (uvwz[2] < 0.5) {
+            const double d_min = *r - atm.bottom_radius;
+            const double d_max = rho;
+            const double d =
+                d_min + (d_max - d_min) * GetUnitRangeFromTextureCoord(1.0 - 2.0 * uvwz[2], half);
+            *mu = d == 0.0 ? -1.0 : ClampCosine(-(rho * rho + d * d) / (2.0 * *r * d));
+            *ray_r_mu_intersects_ground = true;
+        } else {
+            const double d_min = atm.top_radius - *r;
+            const double d_max = rho + H;
+            const double d =
+                d_min + (d_max - d_min) * GetUnitRangeFromTextureCoord(2.0 * uvwz[2] - 1.0, half);
+            *mu = d == 0.0 ? 1.0 : ClampCosine((H * H - rho * rho - d * d) / (2.0 * *r * d));
+            *ray_r_mu_intersects_ground = false;
+        }
+        const double x_mu_s = GetUnitRangeFromTextureCoord(uvwz[1], cfg.scattering_mu_s);
+        const double d_min = atm.top_radius - atm.bottom_radius;
+        const double d_max = H;
+        const double D =
+            DistanceToTopAtmosphereBoundary(atm.bottom_radius, atm.mu_s_min, atm.top_radius);
+        const double A = (D - d_min) / (d_max - d_min);
+        const double a = (A - x_mu_s * A) / (1.0 + x_mu_s * A);
+        const double d = d_min + Min(a, A) * (d_max - d_min);
+        *mu_s = d == 0.0 ? 1.0 : ClampCosine((H * H - d * d) / (2.0 * atm.bottom_radius * d));
+        *nu = ClampCosine(uvwz[0] * 2.0 - 1.0);
+    }
+    // GetRMuMuSNuFromScatteringTextureFragCoord for texel (x, y, z) of the 3D
+    // table (x = nu * MU_S + mu_s): texel centres, nu clamped to its range given
+    // mu and mu_s.
+    ATMOS_HD void RMuMuSNuFromTexel(int x, int y, int z, double* r, double* mu, double* mu_s,
+                                    double* nu, bool* ray_r_mu_intersects_ground) const {
+        const int nu_index = x / cfg.scattering_mu_s;
+        const int mu_s_index = x % cfg.scattering_mu_s;
+        const double uvwz[4] = {
+            cfg.scattering_nu > 1 ? static_cast<double>(nu_index) / (cfg.scattering_nu - 1) : 0.5,
+            (mu_s_index + 0.5) / cfg.scattering_mu_s, (y + 0.5) / cfg.scattering_mu,
+            (z + 0.5) / cfg.scattering_r};
+        RMuMuSNuFromScatteringUvwz(uvwz, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
+        const double s = SafeSqrt((1.0 - *mu * *mu) * (1.0 - *mu_s * *mu_s));
+        *nu = Clamp(*nu, *mu * *mu_s - s, *mu * *mu_s + s);
+    }
+
+    // 4D lookup as two 3D lookups (seed 004 GetScattering), from the mapped
+    // coordinates; quadrilinear interpolation.
+    ATMOS_HD static Vec4f Lookup4D(const TableView& table, int nu_size, const double uvwz[4]) {
+        const double tex_coord_x = uvwz[0] * (nu_size - 1);
+        const double tex_x = floor(tex_coord_x);
+        const float lerp = static_cast<float>(tex_coord_x - tex_x);
+        const double u0 = (tex_x + uvwz[1]) / nu_size;
+        const double u1 = (tex_x + 1.0 + uvwz[1]) / nu_size;
+        return table.SampleTrilinear(u0, uvwz[2], uvwz[3]) * (1.0f - lerp) +
+               table.SampleTrilinear(u1, uvwz[2], uvwz[3]) * lerp;
+    }
+    ATMOS_HD Vec4f GetScattering(const TableView& table, double r, double mu, double mu_s,
+                                 double nu, bool ray_r_mu_intersects_ground) const {
+        double uvwz[4];
+        ScatteringUvwz(ClampRadius(r), ClampCosine(mu), ClampCosine(mu_s), ClampCosine(nu),
+                       ray_r_mu_intersects_ground, uvwz);
+        return Lookup4D(table, cfg.scattering_nu, uvwz);
+    }
+
+    // Seed 004 GetExtrapolatedSingleMieScattering (combined storage).
+    ATMOS_HD Rgb ExtrapolatedSingleMie(const Vec4f& s) const {
+        if (s.x <= 0.0f) return Rgb(0.0f);
+        const Vec3d ratio = atm.mie_scattering / atm.rayleigh_scattering *
+                            (atm.rayleigh_scattering.x / atm.mie_scattering.x);
+        return s.rgb() * (s.w / s.x) * Rgb(ratio);
+    }
+    // Seed 004 GetCombinedScattering: Rayleigh + multiple scattering, and the
+    // single Mie scattering (without phase functions).
+    ATMOS_HD Rgb CombinedScattering(double r, double mu, double mu_s, double nu,
+                                    bool ray_r_mu_intersects_ground, Rgb* single_mie) const {
+        double uvwz[4];
+        ScatteringUvwz(ClampRadius(r), ClampCosine(mu), ClampCosine(mu_s), ClampCosine(nu),
+                       ray_r_mu_intersects_ground, uvwz);
+        const Vec4f s = Lookup4D(scattering_table, cfg.scattering_nu, uvwz);
+        if (cfg.combined_mie) {
+            *single_mie = ExtrapolatedSingleMie(s);
+        } else {
+            *single_mie = Lookup4D(single_mie_table, cfg.scattering_nu, uvwz).rgb();
+        }
+        return s.rgb();
+    }
+
+    // ---- irradiance (seed 004, "Ground irradiance") ----
+    ATMOS_HD void IrradianceUvFromRMuS(double r, double mu_s, double* u, double* v) const {
+        const double x_r = (r - atm.bottom_radius) / (atm.top_radius - atm.bottom_radius);
+        const double x_mu_s = mu_s * 0.5 + 0.5;
+        *u = GetTextureCoordFromUnitRange(x_mu_s, cfg.irradiance_width);
+        *v = GetTextureCoordFromUnitRange(x_r, cfg.irradiance_height);
+    }
+    ATMOS_HD void RMuSFromIrradianceUv(double u, double v, double* r, double* mu_s) const {
+        const double x_mu_s = GetUnitRangeFromTextureCoord(u, cfg.irradiance_width);
+        const double x_r = GetUnitRangeFromTextureCoord(v, cfg.irradiance_height);
+        *r = atm.bottom_radius + x_r * (atm.top_radius - atm.bottom_radius);
+        *mu_s = ClampCosine(2.0 * x_mu_s - 1.0);
+    }
+    ATMOS_HD Rgb GetIrradiance(const TableView& table, double r, double mu_s) const {
+        double u, v;
+        IrradianceUvFromRMuS(ClampRadius(r), ClampCosine(mu_s), &u, &v);
+        return table.SampleBilinear(u, v).rgb();
+    }
+    // Seed 004 ComputeDirectIrradiance (per unit solar irradiance): the average
+    // cosine over the visible part of the sun's disc times T to the top.
+    ATMOS_HD Rgb DirectIrradiance(double r, double mu_s) const {
+        const double alpha_s = atm.sun_angular_radius;
+        const double c =
+            mu_s < -alpha_s
+                ? 0.0
+                : (mu_s > alpha_s ? mu_s : (mu_s + alpha_s) * (mu_s + alpha_s) / (4.0 * alpha_s));
+        return TransmittanceToTop(r, mu_s) * static_cast<float>(c);
+    }
+
+    // ---- rendering (seed 004, "Rendering") ----
+    // GetSkyRadiance, per unit solar irradiance. `ray_hits_ground` is the
+    // caller's (robust) answer to "does the view ray meet the ground".
+    ATMOS_HD Rgb SkyRadiance(Vec3d camera, const Vec3d& view_ray, double shadow_length,
+                             const Vec3d& sun_direction, bool ray_hits_ground,
+                             Rgb* transmittance_out) const {
+        double r = Length(camera);
+        double rmu = Dot(camera, view_ray);
+        const double disc = rmu * rmu - r * r + atm.top_radius * atm.top_radius;
+        const double to_top = disc >= 0.0 ? -rmu - Sqrt(disc) : -1.0;
+        if (r > atm.top_radius) {
+            if (to_top > 0.0) {
+                camera = camera + view_ray * to_top;
+                r = atm.top_radius;
+                rmu += to_top;
+            } else {
+                *transmittance_out = Rgb(1.0f);
+                return Rgb(0.0f);
+            }
+        }
+        r = ClampRadius(r);
+        const double mu = ClampCosine(rmu / r);
+        const double mu_s = ClampCosine(Dot(camera, sun_direction) / r);
+        const double nu = ClampCosine(Dot(view_ray, sun_direction));
+        *transmittance_out = ray_hits_ground ? Rgb(0.0f) : TransmittanceToTop(r, mu);
+        Rgb single_mie, scattering;
+        if (shadow_length == 0.0) {
+            scattering = CombinedScattering(r, mu, mu_s, nu, ray_hits_ground, &single_mie);
+        } else {
+            // Light shafts (seed 004; paper Eq. 18): omit the first l metres.
+            const double d = shadow_length;
+            const double r_p = ClampRadius(Sqrt(d * d + 2.0 * r * mu * d + r * r));
+            const double mu_p = (r * mu + d) / r_p;
+            const double mu_s_p = (r * mu_s + d * nu) / r_p;
+            scattering = CombinedScattering(r_p, mu_p, mu_s_p, nu, ray_hits_ground, &single_mie);
+            const Rgb shadow_t = Transmittance(r, mu, shadow_length, ray_hits_ground);
+            scattering = scattering * shadow_t;
+            single_mie = single_mie * shadow_t;
+        }
+        return scattering * static_cast<float>(RayleighPhase(nu)) +
+               single_mie * static_cast<float>(CornetteShanksPhase(atm.mie_phase_g, nu));
+    }
+
+    // GetSkyRadianceToPoint: scattering between the camera and `point` (aerial
+    // perspective) as the difference of two lookups, and the transmittance.
+    ATMOS_HD Rgb SkyRadianceToPoint(Vec3d camera, const Vec3d& point, double shadow_length,
+                                    const Vec3d& sun_direction, bool ray_hits_ground,
+                                    Rgb* transmittance_out) const {
+        const Vec3d view_ray = Normalize(point - camera);
+        double r = Length(camera);
+        double rmu = Dot(camera, view_ray);
+        const double disc = rmu * rmu - r * r + atm.top_radius * atm.top_radius;
+        const double to_top = disc >= 0.0 ? -rmu - Sqrt(disc) : -1.0;
+        if (r > atm.top_radius && to_top > 0.0) {
+            camera = camera + view_ray * to_top;
+            r = atm.top_radius;
+            rmu += to_top;
+        }
+        r = ClampRadius(r);
+        const double mu = ClampCosine(rmu / r);
+        const double mu_s = ClampCosine(Dot(camera, sun_direction) / r);
+        const double nu = ClampCosine(Dot(view_ray, sun_direction));
+        double d = Length(point - camera);
+        *transmittance_out = Transmittance(r, mu, d, ray_hits_ground);
+        Rgb single_mie;
+        Rgb scattering = CombinedScattering(r, mu, mu_s, nu, ray_hits_ground, &single_mie);
+        // Second lookup at the point, or shadow_length before it (paper Eq. 17).
+        d = Max(d - shadow_length, 0.0);
+        const double r_p = ClampRadius(Sqrt(d * d + 2.0 * r * mu * d + r * r));
+        const double mu_p = (r * mu + d) / r_p;
+        const double mu_s_p = (r * mu_s + d * nu) / r_p;
+        Rgb single_mie_p;
+        const Rgb scattering_p =
+            CombinedScattering(r_p, mu_p, mu_s_p, nu, ray_hits_ground, &single_mie_p);
+        Rgb shadow_t = *transmittance_out;
+        if (shadow_length > 0.0) shadow_t = Transmittance(r, mu, d, ray_hits_ground);
+        scattering = scattering - shadow_t * scattering_p;
+        single_mie = single_mie - shadow_t * single_mie_p;
+        if (cfg.combined_mie) {
+            Vec4f s;
+            s.x = scattering.x;
+            s.y = scattering.y;
+            s.z = scattering.z;
+            s.w = single_mie.x;
+            single_mie = ExtrapolatedSingleMie(s);
+        }
+        // Seed 004's hack against artefacts with the sun below the horizon.
+        single_mie = single_mie * static_cast<float>(SmoothStep(0.0, 0.01, mu_s));
+        return Max(scattering, Rgb(0.0f)) * static_cast<float>(RayleighPhase(nu)) +
+               Max(single_mie, Rgb(0.0f)) *
+                   static_cast<float>(CornetteShanksPhase(atm.mie_phase_g, nu));
+    }
+
+    // GetSunAndSkyIrradiance (per unit solar irradiance) at `point` with
+    // `normal`: returns the sun's, writes the sky's (horizontal-surface table
+    // times (1 + n.up) / 2, the paper's approximation).
+    ATMOS_HD Rgb SunAndSkyIrradiance(const Vec3d& point, const Vec3d& normal,
+                                     const Vec3d& sun_direction, Rgb* sky_irradiance) const {
+        const double r = ClampRadius(Length(point));
+        const double mu_s = ClampCosine(Dot(point, sun_direction) / Length(point));
+        *sky_irradiance = GetIrradiance(irradiance_table, r, mu_s) *
+                          static_cast<float>((1.0 + Dot(normal, point) / Length(point)) * 0.5);
+        return TransmittanceToSun(r, mu_s) *
+               static_cast<float>(Max(Dot(normal, sun_direction), 0.0));
+    }
+
+    ATMOS_HD static double SmoothStep(double e0, double e1, double x) {
+        const double t = Clamp((x - e0) / (e1 - e0), 0.0, 1.0);
+        return t * t * (3.0 - 2.0 * t);
+    }
+    // min(t, 1) and 0 for a non-finite ratio (0 / 0 at T = 0).
+    ATMOS_HD static Rgb SafeRatio(const Rgb& t) {
+        Rgb out;
+        for (int i = 0; i < 3; ++i) out[i] = IsFinite(t[i]) ? Clamp(t[i], 0.0f, 1.0f) : 0.0f;
+        return out;
+    }
+};
+
+// The per-pixel evaluator: sky radiance (to space, or to the ground point),
+// the lit ground, and the transmittance.
+struct BrunetonEvaluator {
+    BrunetonLut lut;
+
+    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                                bool want_ground) const {
+        RayResult out;
+        out.transmittance = Rgb(1.0f);
+        const AtmosphereParameters& atm = lut.atm;
+        const AtmosphereSegment seg =
+            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
+        out.hits_ground = seg.hits_ground;
+        if (!seg.inside && !seg.hits_ground) return out;  // misses the atmosphere: L = 0, T = 1
+        if (!seg.hits_ground) {
+            out.sky = lut.SkyRadiance(camera, dir, 0.0, sun, false, &out.transmittance);
+            return out;
+        }
+        // A camera on the ground looking down sees the ground at its feet (zero
+        // length: no scattering, T = 1).
+        const Vec3d ground = seg.inside ? camera + dir * seg.t_end : camera;
+        if (seg.inside) {
+            out.sky = lut.SkyRadianceToPoint(camera, ground, 0.0, sun, true, &out.transmittance);
+        }
+        if (want_ground && MaxComponent(atm.ground_albedo) > 0.0) {
+            const Vec3d normal = Normalize(ground);
+            Rgb sky_irradiance;
+            const Rgb sun_irradiance =
+                lut.SunAndSkyIrradiance(ground, normal, sun, &sky_irradiance);
+            out.ground = Rgb(atm.ground_albedo * (1.0 / kPi)) * (sun_irradiance + sky_irradiance) *
+                         out.transmittance;
+        }
+        return out;
+    }
+};
+
+// Host-owned tables of one precomputation.
+struct BrunetonTables {
+    Table transmittance;  // W x H, 3 channels
+    Table irradiance;     // W x H, 3 channels
+    Table scattering;     // NU*MU_S x MU x R, 3 or 4 channels
+    Table single_mie;     // same size, 3 channels (separate storage), else empty
+};
+
+// Seconds per precomputation stage.
+struct BrunetonStageTimes {
+    double transmittance = 0.0;
+    double direct_irradiance = 0.0;
+    double single_scattering = 0.0;
+    double scattering_density = 0.0;  // all orders together
+    double indirect_irradiance = 0.0;
+    double multiple_scattering = 0.0;
+    double total = 0.0;
+};
+struct BrunetonTimings {
+    BrunetonStageTimes wall;  // wall clock
+    BrunetonStageTimes cpu;   // process CPU time (all threads: std::clock)
+};
+
+// Called with the tables as they stand after each scattering order (1..N), and
+// that order's scattering density J_n (nullptr for order 1): for tests.
+using BrunetonOrderCallback =
+    std::function<void(int order, const BrunetonTables& tables, const Table* density)>;
+
+// The whole precomputation of seed 004 on the CPU (ParallelFor). Tables are per
+// unit solar irradiance. Throws atmos::Error for an invalid configuration.
+void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
+                        BrunetonTables* tables, BrunetonTimings* timings = nullptr,
+                        const BrunetonOrderCallback& on_order = nullptr);
+
+// Checks sizes and orders; throws atmos::Error naming the bad option.
+void ValidateBrunetonConfig(const BrunetonConfig& config);
+
+// A lookup over `tables`.
+BrunetonLut MakeBrunetonLut(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
+                            const BrunetonTables& tables);
+
+class BrunetonModel : public EvaluatorModel<BrunetonModel> {
+  public:
+    explicit BrunetonModel(const ModelOptions& options);
+    static ModelInfo StaticInfo();
+    const ModelInfo& Info() const override { return info_; }
+    void Prepare(const AtmosphereParameters& atmosphere) override;
+    BrunetonEvaluator MakeEvaluator() const;
+    const AtmosphereParameters& atmosphere() const { return atm_; }
+
+    bool CanBake() const override { return true; }
+    void Bake(const std::string& directory) const override;
+    void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere) override;
+
+    const BrunetonConfig& config() const { return config_; }
+    const BrunetonTables& tables() const { return tables_; }
+    const BrunetonTimings& timings() const { return timings_; }
+
+  private:
+    ModelInfo info_;
+    BrunetonConfig config_;
+    AtmosphereParameters atm_;
+    BrunetonTables tables_;
+    BrunetonTimings timings_;
+    bool prepared_ = false;
+};
+
+}  // namespace atmos
