@@ -4,6 +4,7 @@
 // the models' evaluators); built for the architectures of ATMOS_CUDA_ARCHITECTURES.
 #include <cuda_runtime.h>
 
+#include "models/atmosphere_plus.h"
 #include "models/empty.h"
 #include "models/naive.h"
 #include "render/render.h"
@@ -35,6 +36,8 @@ template cudaError_t LaunchRender<EmptyEvaluator>(const EmptyEvaluator&, const P
                                                   cudaStream_t);
 template cudaError_t LaunchRender<NaiveEvaluator>(const NaiveEvaluator&, const PixelSetup&, float*,
                                                   cudaStream_t);
+template cudaError_t LaunchRender<AtmospherePlusEvaluator>(const AtmospherePlusEvaluator&,
+                                                           const PixelSetup&, float*, cudaStream_t);
 
 }  // namespace cuda
 }  // namespace atmos

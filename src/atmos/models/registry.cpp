@@ -6,6 +6,7 @@
 
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "models/atmosphere_plus.h"
 #include "models/empty.h"
 #include "models/naive.h"
 
@@ -28,6 +29,7 @@ const std::vector<Entry>& Registry() {
     static const std::vector<Entry> entries = {
         MakeEntry<EmptyModel>(),
         MakeEntry<NaiveModel>(),
+        MakeEntry<AtmospherePlusModel>(),
     };
     return entries;
 }
