@@ -221,7 +221,7 @@ ModelInfo AtmospherePlusModel::StaticInfo() {
     info.options = {
         {"parameterization",
          T::kChoice,
-         "nonlinear",
+         "horizon",
          "table mapping (seed 000 2.4)",
          0,
          0,
@@ -229,7 +229,7 @@ ModelInfo AtmospherePlusModel::StaticInfo() {
         {"table-width", T::kInteger, "32", "table size over altitude (u)", 2, 1024, {}},
         {"table-height",
          T::kInteger,
-         "256",
+         "64",
          "table size over view zenith (v): 256, 128 or 64",
          2,
          4096,

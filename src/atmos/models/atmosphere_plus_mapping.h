@@ -40,7 +40,7 @@ ATMOS_HD inline double AplusSignedPow(double x, double p) {
 }
 
 struct AplusMapping {
-    AplusParameterization kind = AplusParameterization::kNonlinear;
+    AplusParameterization kind = AplusParameterization::kHorizon;
     AplusHorizonAngle horizon_angle = AplusHorizonAngle::kGeometric;
     double bottom_radius = 6360e3;  // R_p
     double height = 100e3;          // H_a = R_a - R_p
