@@ -154,5 +154,87 @@ TEST(AtmospherePlusStudy, DISABLED_ParameterizationTable) {
     }
 }
 
+// The full model (5 orders, the seed's 6 x 12 gather): table error against the
+// same numerics in a 64 x 256 x 64 horizon-centric table (stand-in), and the
+// effect of the seed's coarse gather against a 24 x 48 gather (same table).
+AtmospherePlusEvaluator MakeEval(const AtmosphereParameters& atm, const AplusSettings& s,
+                                 const AplusTables& t) {
+    AtmospherePlusEvaluator e;
+    e.atm = atm;
+    e.mapping = s.mapping;
+    e.mapping.bottom_radius = atm.bottom_radius;
+    e.mapping.height = atm.top_radius - atm.bottom_radius;
+    e.scattering = t.scattering.view();
+    e.transmittance = t.transmittance.view();
+    return e;
+}
+
+TEST(AtmospherePlusStudy, DISABLED_MultipleScatteringTable) {
+    AtmosphereParameters atm = LoadAtmosphere("earth-atmosphere-plus");
+    atm.solar_irradiance = Vec3d(1.0);
+    const std::vector<View> views = StandardViews(atm);
+    const auto settings = [](AplusParameterization kind, int w, int h, int d, int gt, int gp) {
+        AplusSettings s;
+        s.mapping.kind = kind;
+        s.width = w;
+        s.height = h;
+        s.depth = d;
+        s.gather_theta = gt;
+        s.gather_phi = gp;
+        return s;
+    };
+    const AplusSettings ref_s = settings(AplusParameterization::kHorizon, 64, 256, 64, 6, 12);
+    const AplusTables ref_t = AplusPrecompute(atm, ref_s);
+    std::printf("stand-in 64x256x64: order seconds");
+    for (double sec : ref_t.order_seconds) std::printf(" %.2f", sec);
+    std::printf("\n");
+    const AtmospherePlusEvaluator ref_e = MakeEval(atm, ref_s, ref_t);
+    std::vector<std::vector<Rgb>> reference;
+    for (const View& v : views) reference.push_back(RenderWith(&ref_e, nullptr, atm, v));
+    struct Case {
+        const char* name;
+        AplusSettings s;
+    };
+    const std::vector<Case> cases = {
+        {"horizon 32x64x32", settings(AplusParameterization::kHorizon, 32, 64, 32, 6, 12)},
+        {"horizon 32x256x32", settings(AplusParameterization::kHorizon, 32, 256, 32, 6, 12)},
+        {"nonlinear 32x256x32", settings(AplusParameterization::kNonlinear, 32, 256, 32, 6, 12)},
+        {"horizon 64x64x64", settings(AplusParameterization::kHorizon, 64, 64, 64, 6, 12)},
+    };
+    std::printf("| table (5 orders) | MiB |");
+    for (const View& v : views) std::printf(" %s |", v.name.c_str());
+    std::printf(" mean |\n");
+    std::vector<std::vector<Rgb>> default_images;
+    for (const Case& c : cases) {
+        const AplusTables t = AplusPrecompute(atm, c.s);
+        const AtmospherePlusEvaluator e = MakeEval(atm, c.s, t);
+        std::printf("| %s | %.2f |", c.name,
+                    static_cast<double>(t.scattering.size() * sizeof(float)) / 1048576.0);
+        double sum = 0.0, sum_d = 0.0;
+        for (size_t v = 0; v < views.size(); ++v) {
+            std::vector<Rgb> img = RenderWith(&e, nullptr, atm, views[v]);
+            const Errors err = Compare(img, reference[v], views[v].exposure);
+            std::printf(" %.3f / %.4f |", err.rel_rmse, err.display_rmse);
+            sum += err.rel_rmse;
+            sum_d += err.display_rmse;
+            if (default_images.size() < views.size()) default_images.push_back(img);
+        }
+        std::printf(" %.3f / %.4f |\n", sum / static_cast<double>(views.size()),
+                    sum_d / static_cast<double>(views.size()));
+        std::fflush(stdout);
+    }
+    // Gather resolution: the seed's 6 x 12 against 24 x 48, default table.
+    const AplusSettings fine_s = settings(AplusParameterization::kHorizon, 32, 64, 32, 24, 48);
+    const AplusTables fine_t = AplusPrecompute(atm, fine_s);
+    const AtmospherePlusEvaluator fine_e = MakeEval(atm, fine_s, fine_t);
+    std::printf("| gather 6x12 vs 24x48 (horizon 32x64x32) | |");
+    for (size_t v = 0; v < views.size(); ++v) {
+        const Errors err = Compare(default_images[v], RenderWith(&fine_e, nullptr, atm, views[v]),
+                                   views[v].exposure);
+        std::printf(" %.3f / %.4f |", err.rel_rmse, err.display_rmse);
+    }
+    std::printf("\n");
+}
+
 }  // namespace
 }  // namespace atmos

@@ -1,9 +1,13 @@
 // Tests of the `atmosphere-plus` model (seed 000): mappings, integration rules,
 // tables against direct integration, scattering orders, rendering.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -488,6 +492,29 @@ TEST(AtmospherePlus, RendersAllParameterizationsAndRejectsBadOptions) {
     EXPECT_THROW(CreateModel("atmosphere-plus", {{"orders", "0"}}), Error);
     auto unprepared = CreateModel("atmosphere-plus");
     EXPECT_THROW(unprepared->Sample({{0.0, 1.0, 1.0, 0.0}}), Error);
+}
+
+TEST(AtmospherePlus, BakeAndLoadRoundTrip) {
+    const std::string dir = std::string(ATMOS_TEST_TMP) + "/aplus_bake_" +
+                            std::to_string(static_cast<long>(::getpid()));
+    std::filesystem::create_directories(dir);
+    auto model = SmallModel();
+    ASSERT_TRUE(model->CanBake());
+    model->Prepare(SeedAtmosphere());
+    model->Bake(dir);
+    auto loaded = SmallModel();
+    loaded->LoadBaked(dir, SeedAtmosphere());
+    const std::vector<SampleQuery> q = {{100.0, 0.3, 0.2, 0.0}, {2e6, -0.6, 0.5, 90.0}};
+    const auto a = model->Sample(q);
+    const auto b = loaded->Sample(q);
+    for (size_t i = 0; i < q.size(); ++i) {
+        EXPECT_EQ(a[i].radiance.y, b[i].radiance.y);
+        EXPECT_EQ(a[i].transmittance.z, b[i].transmittance.z);
+    }
+    auto other = SmallModel({{"parameterization", "linear"}});
+    EXPECT_THROW(other->LoadBaked(dir, SeedAtmosphere()), Error);
+    EXPECT_THROW(loaded->LoadBaked(dir, EarthAtmosphere()), Error);
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace

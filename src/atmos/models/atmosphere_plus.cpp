@@ -5,8 +5,15 @@
 #include <cmath>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
 #include "atmos/error.h"
 #include "base/parallel.h"
+#include "io/table_io.h"
 
 namespace atmos {
 
@@ -342,6 +349,91 @@ void AtmospherePlusModel::Prepare(const AtmosphereParameters& atmosphere) {
     settings_.mapping.bottom_radius = atm_.bottom_radius;
     settings_.mapping.height = atm_.top_radius - atm_.bottom_radius;
     tables_ = AplusPrecompute(atm_, settings_);
+}
+
+namespace {
+
+// Everything that determines the tables' content, for the bake's JSON.
+nlohmann::json SettingsJson(const AplusSettings& s) {
+    const char* kinds[] = {"linear", "nonlinear", "power", "horizon"};
+    const AplusMapping& m = s.mapping;
+    nlohmann::json j;
+    j["parameterization"] = kinds[static_cast<int>(m.kind)];
+    j["horizon_angle"] = m.horizon_angle == AplusHorizonAngle::kSeed ? "seed" : "geometric";
+    j["p_u"] = m.p_u;
+    j["p_v"] = m.p_v;
+    j["p_w"] = m.p_w;
+    j["p_a"] = m.p_a;
+    j["p_s"] = m.p_s;
+    j["surface_ratio"] = m.s;
+    j["table_size"] = {s.width, s.height, s.depth};
+    j["transmittance_size"] = {s.transmittance_width, s.transmittance_height};
+    j["orders"] = s.orders;
+    j["transmittance_steps"] = s.transmittance_steps;
+    j["gather"] = {s.gather_theta, s.gather_phi};
+    return j;
+}
+
+}  // namespace
+
+void AtmospherePlusModel::Bake(const std::string& directory) const {
+    if (tables_.scattering.size() == 0) Fail("atmosphere-plus: nothing to bake before Prepare()");
+    namespace fs = std::filesystem;
+    WriteTableExr(tables_.scattering, (fs::path(directory) / "scattering.exr").string());
+    WriteTableExr(tables_.transmittance, (fs::path(directory) / "transmittance.exr").string());
+    nlohmann::json j;
+    j["model"] = "atmosphere-plus";
+    j["settings"] = SettingsJson(settings_);
+    j["scattering"] = {
+        {"file", "scattering.exr"},
+        {"layout",
+         "W*D x H pixels: D layers (sun zenith, w) side by side; x: altitude (u), "
+         "y: view zenith (v); texel i holds the value at i/(size-1) of seed 000 2.4"},
+        {"channels", "R, G, B: Rayleigh factored intensity; A: Mie (green channel)"}};
+    j["transmittance"] = {{"file", "transmittance.exr"},
+                          {"layout", "W x H: altitude (u) x view zenith (v), same mapping"}};
+    j["atmosphere"] = nlohmann::json::parse(AtmosphereToJson(atm_));
+    std::ofstream out(fs::path(directory) / "atmosphere-plus.json");
+    out << j.dump(2) << "\n";
+    if (!out) Fail("atmosphere-plus: cannot write ", directory, "/atmosphere-plus.json");
+}
+
+void AtmospherePlusModel::LoadBaked(const std::string& directory,
+                                    const AtmosphereParameters& atmosphere) {
+    namespace fs = std::filesystem;
+    const fs::path json_path = fs::path(directory) / "atmosphere-plus.json";
+    std::ifstream in(json_path);
+    if (!in) Fail("atmosphere-plus: cannot read ", json_path.string());
+    std::stringstream text;
+    text << in.rdbuf();
+    nlohmann::json j;
+    try {
+        j = nlohmann::json::parse(text.str());
+    } catch (const std::exception& e) {
+        Fail("atmosphere-plus: ", json_path.string(), " is not valid JSON: ", e.what());
+    }
+    AplusSettings s = settings_;
+    s.mapping.bottom_radius = atmosphere.bottom_radius;
+    s.mapping.height = atmosphere.top_radius - atmosphere.bottom_radius;
+    if (!j.contains("settings") || j["settings"] != SettingsJson(s)) {
+        Fail("atmosphere-plus: the tables in ", directory, " were baked with other model options (",
+             j.value("settings", nlohmann::json()).dump(), ")");
+    }
+    if (!j.contains("atmosphere") ||
+        j["atmosphere"] != nlohmann::json::parse(AtmosphereToJson(atmosphere))) {
+        Fail("atmosphere-plus: the tables in ", directory, " were baked for another atmosphere");
+    }
+    AplusTables t;
+    t.scattering = ReadTableExr((fs::path(directory) / "scattering.exr").string(), s.depth, 4);
+    t.transmittance = ReadTableExr((fs::path(directory) / "transmittance.exr").string(), 1, 3);
+    if (t.scattering.width() != s.width || t.scattering.height() != s.height ||
+        t.transmittance.width() != s.transmittance_width ||
+        t.transmittance.height() != s.transmittance_height) {
+        Fail("atmosphere-plus: table sizes in ", directory, " do not match the options");
+    }
+    atm_ = atmosphere;
+    settings_ = s;
+    tables_ = std::move(t);
 }
 
 AtmospherePlusEvaluator AtmospherePlusModel::MakeEvaluator() const {

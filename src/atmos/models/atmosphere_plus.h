@@ -278,6 +278,12 @@ class AtmospherePlusModel : public EvaluatorModel<AtmospherePlusModel> {
     const AplusSettings& settings() const { return settings_; }
     const AplusTables& tables() const { return tables_; }
 
+    // `atmos bake`: scattering.exr (W*D x H, RGBA), transmittance.exr (RGB) and
+    // atmosphere-plus.json (sizes, mapping, numerics, the atmosphere).
+    bool CanBake() const override { return true; }
+    void Bake(const std::string& directory) const override;
+    void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere) override;
+
   private:
     ModelInfo info_;
     AplusSettings settings_;
