@@ -490,6 +490,11 @@ TEST(AtmospherePlus, RendersAllParameterizationsAndRejectsBadOptions) {
     EXPECT_THROW(CreateModel("atmosphere-plus", {{"parameterization", "cubic"}}), Error);
     EXPECT_THROW(CreateModel("atmosphere-plus", {{"table-height", "1"}}), Error);
     EXPECT_THROW(CreateModel("atmosphere-plus", {{"orders", "0"}}), Error);
+    EXPECT_THROW(CreateModel("atmosphere-plus", {{"parameterization", "linear"}, {"p-u", "2"}}),
+                 Error);
+    EXPECT_THROW(CreateModel("atmosphere-plus", {{"parameterization", "power"}, {"p-a", "2"}}),
+                 Error);
+    EXPECT_NO_THROW(CreateModel("atmosphere-plus", {{"parameterization", "power"}, {"p-v", "2"}}));
     auto unprepared = CreateModel("atmosphere-plus");
     EXPECT_THROW(unprepared->Sample({{0.0, 1.0, 1.0, 0.0}}), Error);
 }

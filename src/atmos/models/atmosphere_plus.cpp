@@ -319,6 +319,20 @@ AplusSettings AplusSettingsFromOptions(const ModelOptions& o) {
                                         : AplusParameterization::kHorizon;
     s.mapping.horizon_angle = o.GetText("horizon-angle") == "seed" ? AplusHorizonAngle::kSeed
                                                                    : AplusHorizonAngle::kGeometric;
+    // Options that the chosen mapping ignores are errors, not silent no-ops.
+    const bool power = s.mapping.kind == AplusParameterization::kPower;
+    const bool horizon = s.mapping.kind == AplusParameterization::kHorizon;
+    for (const char* name : {"p-u", "p-v", "p-w", "p-a", "p-s", "surface-ratio", "horizon-angle"}) {
+        const std::string n = name;
+        const bool used = (n == "p-u" || n == "p-w") ? (power || horizon)
+                          : n == "p-v"               ? power
+                                                     : horizon;
+        if (o.WasSet(n) && !used) {
+            Fail("atmosphere-plus: --", n, " does not apply to --parameterization ", p,
+                 " (p-u, p-w: power and horizon; p-v: power; p-a, p-s, surface-ratio, "
+                 "horizon-angle: horizon)");
+        }
+    }
     s.mapping.p_u = o.GetReal("p-u");
     s.mapping.p_v = o.GetReal("p-v");
     s.mapping.p_w = o.GetReal("p-w");
