@@ -151,6 +151,9 @@ struct AplusSettings {
     AplusMapping mapping;  // default: horizon-centric (the lowest measured error)
     int width = 32, height = 64, depth = 32;  // seed 000 2.4: (32, 256|128|64, 32)
     int transmittance_width = 64, transmittance_height = 256;
+    // Numerics: the seed text gives n = 30 (1.10) only; K = 5 and the 6 x 12
+    // gather (30 degree steps) are the constants of the seed author's solver
+    // (atmosphere-plus repository, atmo_solver.c: ATMO_K, ATMO_GATHER_M/N_STEPS).
     int orders = 5;                  // K
     int transmittance_steps = 30;    // seed 000 1.10: n = 30
     int gather_theta = 6;            // 2D trapezoid intervals over Theta in [0, pi]
