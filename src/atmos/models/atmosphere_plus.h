@@ -177,19 +177,49 @@ AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings
 void AplusTexelParameters(const AplusMapping& mapping, int x, int y, int z, int width, int height,
                           int depth, double* h, double* mu, double* mu_s);
 
-// Samples a table laid out as the scattering table at (h, mu, mu_s).
+// Samples a table laid out as the scattering table at (h, mu, mu_s): linear
+// between the two altitude rows around h, and in each row bilinear in (v, w)
+// with v computed from that row's altitude (the horizon-centric v depends on
+// h). At the ground row (h = 0) a ray below the horizon has no length:
+// `ground_row` (0 for scattering, 1 for transmittance) instead of the texel,
+// which the horizon-centric mapping gives to the horizon there (s u(0) = 0).
+ATMOS_HD inline Vec4f AplusSampleTable(const TableView& t, const AplusMapping& m, double h,
+                                       double mu, double w, const Vec4f& ground_row) {
+    int x0, z0;
+    float fx, fz;
+    TableView::Split(GetTextureCoordFromUnitRange(m.U(h), t.width), t.width, &x0, &fx);
+    TableView::Split(w, t.depth, &z0, &fz);
+    Vec4f out;
+    for (int k = 0; k < 2; ++k) {
+        const float weight = k == 0 ? 1.0f - fx : fx;
+        if (weight == 0.0f) continue;
+        const int x = Min(x0 + k, t.width - 1);
+        const double h_row = m.H(t.width > 1 ? static_cast<double>(x) / (t.width - 1) : 0.0);
+        if (h_row <= 0.0 && mu < 0.0) {
+            out = out + ground_row * weight;
+            continue;
+        }
+        int y0;
+        float fy;
+        TableView::Split(GetTextureCoordFromUnitRange(m.V(h_row, mu), t.height), t.height, &y0,
+                         &fy);
+        const auto layer = [&](int z) {
+            return (t.Fetch(x, y0, z) * (1.0f - fy) + t.Fetch(x, y0 + 1, z) * fy);
+        };
+        const Vec4f row = t.depth > 1 ? layer(z0) * (1.0f - fz) + layer(z0 + 1) * fz : layer(0);
+        out = out + row * weight;
+    }
+    return out;
+}
 ATMOS_HD inline Vec4f AplusSample(const TableView& t, const AplusMapping& m, double h, double mu,
                                   double mu_s) {
-    const double u = GetTextureCoordFromUnitRange(m.U(h), t.width);
-    const double v = GetTextureCoordFromUnitRange(m.V(h, mu), t.height);
-    const double w = GetTextureCoordFromUnitRange(m.W(mu_s), t.depth);
-    return t.SampleTrilinear(u, v, w);
+    return AplusSampleTable(t, m, h, mu, GetTextureCoordFromUnitRange(m.W(mu_s), t.depth), Vec4f());
 }
 ATMOS_HD inline Rgb AplusSampleTransmittance(const TableView& t, const AplusMapping& m, double h,
                                              double mu) {
-    const double u = GetTextureCoordFromUnitRange(m.U(h), t.width);
-    const double v = GetTextureCoordFromUnitRange(m.V(h, mu), t.height);
-    return t.SampleBilinear(u, v).rgb();
+    Vec4f one;
+    one.x = one.y = one.z = 1.0f;
+    return AplusSampleTable(t, m, h, mu, 0.5, one).rgb();
 }
 
 // The per-pixel evaluator (trivially copyable; tables by view).
