@@ -28,14 +28,22 @@ namespace atmos {
 enum class AplusParameterization { kLinear = 0, kNonlinear = 1, kPower = 2, kHorizon = 3 };
 enum class AplusHorizonAngle { kGeometric = 0, kSeed = 1 };
 
+// x^p and x^(1/p) for x >= 0, with exact fast paths for the seed's powers
+// 1, 2 and 3 (per-pixel lookups call these several times).
+ATMOS_HD inline double AplusPow(double x, double p) {
+    return p == 1.0 ? x : p == 2.0 ? x * x : p == 3.0 ? x * x * x : Pow(x, p);
+}
+ATMOS_HD inline double AplusRoot(double x, double p) {
+    return p == 1.0 ? x : p == 2.0 ? Sqrt(x) : p == 3.0 ? cbrt(x) : Pow(x, 1.0 / p);
+}
 // sign(c) |c|^(1/p) -> maps [-1, 1] onto [-1, 1] (seed 000 2.4.3).
 ATMOS_HD inline double AplusSignedRoot(double c, double p) {
-    const double a = Pow(Abs(c), 1.0 / p);
+    const double a = AplusRoot(Abs(c), p);
     return c < 0.0 ? -a : a;
 }
 // Inverse: sign(x) |x|^p.
 ATMOS_HD inline double AplusSignedPow(double x, double p) {
-    const double a = Pow(Abs(x), p);
+    const double a = AplusPow(Abs(x), p);
     return x < 0.0 ? -a : a;
 }
 
@@ -73,13 +81,11 @@ struct AplusMapping {
 
     ATMOS_HD double U(double h) const {
         const double x = Clamp(h / height, 0.0, 1.0);
-        const double p = PowerU();
-        return p == 1.0 ? x : Pow(x, 1.0 / p);
+        return AplusRoot(x, PowerU());
     }
     ATMOS_HD double H(double u) const {
         const double x = Clamp(u, 0.0, 1.0);
-        const double p = PowerU();
-        return (p == 1.0 ? x : Pow(x, p)) * height;
+        return AplusPow(x, PowerU()) * height;
     }
 
     ATMOS_HD double V(double h, double mu) const {
@@ -91,10 +97,10 @@ struct AplusMapping {
         const double su = s * U(h);
         if (mu >= c_h) {
             const double x = Clamp((mu - c_h) / (1.0 - c_h), 0.0, 1.0);
-            return (1.0 - su) * Pow(x, 1.0 / p_a) + su;
+            return (1.0 - su) * AplusRoot(x, p_a) + su;
         }
         const double x = Clamp((mu - c_h) / (-1.0 - c_h), 0.0, 1.0);
-        return su * (1.0 - Pow(x, 1.0 / p_s));
+        return su * (1.0 - AplusRoot(x, p_s));
     }
     ATMOS_HD double Mu(double h, double v) const {
         v = Clamp(v, 0.0, 1.0);
@@ -105,10 +111,10 @@ struct AplusMapping {
         const double su = s * U(h);
         if (v >= su) {
             const double x = su < 1.0 ? (v - su) / (1.0 - su) : 0.0;
-            return Clamp(Pow(x, p_a) * (1.0 - c_h) + c_h, -1.0, 1.0);
+            return Clamp(AplusPow(x, p_a) * (1.0 - c_h) + c_h, -1.0, 1.0);
         }
         const double x = 1.0 - v / su;
-        return Clamp(Pow(x, p_s) * (-1.0 - c_h) + c_h, -1.0, 1.0);
+        return Clamp(AplusPow(x, p_s) * (-1.0 - c_h) + c_h, -1.0, 1.0);
     }
 
     ATMOS_HD double W(double mu_s) const {
