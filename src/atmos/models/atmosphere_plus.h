@@ -44,7 +44,11 @@
 // Mie value without saying which); extinction includes the atmosphere's ozone
 // term (zero in the seed's preset); ground albedo is not used in the orders (the
 // seed has none), the render adds the sun-lit ground only; the horizon-centric
-// mapping uses the geometric horizon by default (atmosphere_plus_mapping.h).
+// mapping uses the geometric horizon by default (atmosphere_plus_mapping.h);
+// lookups interpolate between altitude rows, each row at its own v, and give
+// rays below the horizon at the ground row zero length (AplusSampleTable).
+// Defaults: horizon-centric mapping, 32 x 64 x 32 (the lowest measured table
+// error per MiB, docs/models.md), K = 5, 6 x 12 gather, n = 30.
 #pragma once
 
 #include <string>
