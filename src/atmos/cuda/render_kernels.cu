@@ -5,6 +5,7 @@
 #include <cuda_runtime.h>
 
 #include "models/bruneton.h"
+#include "models/atmosphere_plus.h"
 #include "models/empty.h"
 #include "models/flat.h"
 #include "models/hillaire.h"
@@ -82,6 +83,8 @@ template cudaError_t LaunchRender<TransmittanceEvaluator<PolynomialTransmittance
     cudaStream_t);
 template cudaError_t LaunchRender<BrunetonEvaluator>(const BrunetonEvaluator&, const PixelSetup&,
                                                      float*, cudaStream_t);
+template cudaError_t LaunchRender<AtmospherePlusEvaluator>(const AtmospherePlusEvaluator&,
+                                                           const PixelSetup&, float*, cudaStream_t);
 
 }  // namespace cuda
 }  // namespace atmos

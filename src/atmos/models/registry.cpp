@@ -7,6 +7,7 @@
 #include "atmos/error.h"
 #include "atmos/model.h"
 #include "models/bruneton.h"
+#include "models/atmosphere_plus.h"
 #include "models/empty.h"
 #include "models/flat.h"
 #include "models/hillaire.h"
@@ -56,6 +57,7 @@ const std::vector<Entry>& Registry() {
         MakeEntry<TransmittancePolynomialModel>(),
         MakeEntry<HillaireModel>(),
         MakeEntry<BrunetonModel>(),
+        MakeEntry<AtmospherePlusModel>(),
     };
     return entries;
 }

@@ -1,0 +1,331 @@
+// atmos model `atmosphere-plus`: the 3D-table model without azimuth.
+//
+// Source: J. Boody, "Atmosphere Plus" notes, seed 000 (sections 1.2-2.4); the
+// earlier version, seed 002, differs in constants only (R_p 6371 km, Rayleigh
+// (6.55, 17.3, 23.0)e-6 /m, Mie 2e-6 /m with extinction beta/0.9, g = -0.85 in a
+// Mie phase written with +2g cos) and states the same cube-root mapping.
+//
+// Implements (factored form of section 2.3; Rayleigh in RGB, Mie in alpha):
+//   transmittance  T = exp(-t), t = trapezoidal rule (1.9) of the extinction
+//                  along the segment with `transmittance-steps` (seed: n = 30)
+//                  intervals (1.10);
+//   order 1        I1(P0,V,L) = beta/(4 pi) int p(h) T(Pc,P) T(P,Pa) ds   (2.1, 2.3)
+//                  (trapezoidal rule over the view segment, the same n; a point
+//                  whose sun ray hits the ground contributes 0);
+//   order k        Ik(P0,V,L) = beta/(4 pi) int G(k-1)(P,V,L) p(h) T(P,Pa) ds (2.2, 2.3)
+//                  G(k-1)(P,V,L) = int_4pi F(dot(w,V)) I(k-1)(P,w,L) dw by the 2D
+//                  trapezoidal rule (1.9) over (Theta, Phi) with
+//                  `gather-theta` x `gather-phi` intervals;
+//   table          sum over k = 1..K (`orders`) in a width x height x depth
+//                  table over (h, cos phi, cos delta) (2.4) in one of the four
+//                  parameterizations (atmosphere_plus_mapping.h);
+//   render         L = F_R(nu) I_R + F_M(nu) I_M, the phase functions applied
+//                  per pixel (2.3) in the seed's normalisation (integral 4 pi;
+//                  the 1/(4 pi) lives in the table), optionally the modified
+//                  Rayleigh phase 0.8 (1.4 + 0.5 nu^2) of section 1.7.
+//
+// Output: radiance per unit solar irradiance (1/sr) like every model; the
+// render loop multiplies by the atmosphere's solar_irradiance, which for the
+// seed's preset (data/atmospheres/earth-atmosphere-plus.json) is the seed's
+// spectral intensity of incident light I_I of section 1.2, so I_I is applied
+// exactly once. Transmittance: of the view segment, from a 2D table T(h, mu)
+// (same u, v mapping) computed with the same trapezoidal rule.
+//
+// Valid: any altitude (cameras above the atmosphere are moved to where the view
+// ray enters it, section 2.4: h in [0, H_a]); any sun. The table has no
+// sun-view azimuth: it is exact (up to interpolation) only when sun and view
+// lie in the same vertical plane on the same side (azimuth 0); elsewhere the
+// render-time phase functions stand in for the azimuth (2.4.5).
+//
+// Deviations (docs/models.md): the gather G(k-1) is tabulated on the scattering
+// table's grid and interpolated along the view ray (the seed's solver gathers at
+// every ray sample; same integral, 72x cheaper); Mie "alpha" uses the green
+// channel's beta_M and transmittance (the seed stores one wavelength-independent
+// Mie value without saying which); extinction includes the atmosphere's ozone
+// term (zero in the seed's preset); ground albedo is not used in the orders (the
+// seed has none), the render adds the sun-lit ground only; the horizon-centric
+// mapping uses the geometric horizon by default (atmosphere_plus_mapping.h);
+// lookups interpolate between altitude rows, each row at its own v, and give
+// rays below the horizon at the ground row zero length (AplusSampleTable).
+// Defaults: horizon-centric mapping, 32 x 64 x 32 (the lowest measured table
+// error per MiB, docs/models.md), K = 5, 6 x 12 gather, n = 30.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "atmos/atmosphere.h"
+#include "atmos/model.h"
+#include "base/texture.h"
+#include "models/atmosphere_plus_mapping.h"
+#include "physics/density.h"
+#include "physics/geometry.h"
+#include "physics/phase.h"
+#include "physics/transmittance.h"
+#include "render/render.h"
+
+namespace atmos {
+
+// Seed 000 section 1.7: phase functions normalised to 4 pi over the sphere.
+ATMOS_HD inline double AplusRayleighPhase(double nu) { return 0.75 * (1.0 + nu * nu); }
+ATMOS_HD inline double AplusModifiedRayleighPhase(double nu) {
+    return 0.8 * (1.4 + 0.5 * nu * nu);  // seed 000 1.7 (integrates to 5.013 pi)
+}
+ATMOS_HD inline double AplusMiePhase(double g, double nu) {
+    return 4.0 * kPi * CornetteShanksPhase(g, nu);  // seed 000 1.7 = 4 pi x seed 003 Eq. 5
+}
+
+// The Mie channel stored in alpha (see the header's deviations).
+constexpr int kAplusMieChannel = 1;
+
+ATMOS_HD inline double Channel(const Vec3d& v, int c) { return c == 0 ? v.x : c == 1 ? v.y : v.z; }
+
+struct AplusValue {  // factored intensity: Rayleigh RGB + Mie
+    Vec3d rayleigh;
+    double mie = 0.0;
+    ATMOS_HD AplusValue& operator+=(const AplusValue& o) {
+        rayleigh += o.rayleigh;
+        mie += o.mie;
+        return *this;
+    }
+};
+ATMOS_HD inline AplusValue operator*(const AplusValue& a, double s) {
+    AplusValue r;
+    r.rayleigh = a.rayleigh * s;
+    r.mie = a.mie * s;
+    return r;
+}
+
+// Seed 000 sections 1.10, 2.1, 2.3: the factored single scattering I1 for an
+// observer at altitude h looking along mu with the sun at mu_s (azimuth 0),
+// trapezoidal rule with `steps` intervals along the view segment and
+// `sun_steps` along each sun ray.
+ATMOS_HD inline AplusValue AplusSingleScattering(const AtmosphereParameters& atm, double h,
+                                                 double mu, double mu_s, int steps, int sun_steps) {
+    AplusValue out;
+    const Vec3d p0(0.0, 0.0, atm.bottom_radius + h);
+    const Vec3d view(SafeSqrt(1.0 - mu * mu), 0.0, mu);
+    const Vec3d sun(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
+    const AtmosphereSegment seg = ClipToAtmosphere(p0, view, atm.bottom_radius, atm.top_radius);
+    if (!seg.inside) return out;
+    const double ds = (seg.t_end - seg.t_start) / steps;
+    Vec3d tau_view;  // P_a to the current node
+    Vec3d prev_ext;
+    Vec3d sum_r;
+    double sum_m = 0.0;
+    for (int i = 0; i <= steps; ++i) {
+        const Vec3d p = p0 + view * (seg.t_start + i * ds);
+        const double r = Length(p);
+        const Densities d = GetDensities(atm, r - atm.bottom_radius);
+        const Vec3d ext = Extinction(atm, d);
+        if (i > 0) tau_view += (prev_ext + ext) * (0.5 * ds);
+        prev_ext = ext;
+        const double mu_sun = ClampCosine(Dot(p, sun) / r);
+        if (RayIntersectsGround(r, mu_sun, atm.bottom_radius)) continue;  // P_c on the ground
+        const double length = DistanceToTopAtmosphereBoundary(r, mu_sun, atm.top_radius);
+        const Vec3d tau_sun = OpticalDepth(atm, p, sun, length, sun_steps);
+        const Vec3d t = Exp(-(tau_view + tau_sun));
+        const double w = (i == 0 || i == steps) ? 0.5 * ds : ds;
+        sum_r += t * (d.rayleigh * w);
+        sum_m += Channel(t, kAplusMieChannel) * d.mie * w;
+    }
+    out.rayleigh = atm.rayleigh_scattering * sum_r / (4.0 * kPi);
+    out.mie = Channel(atm.mie_scattering, kAplusMieChannel) * sum_m / (4.0 * kPi);
+    return out;
+}
+
+// Seed 000 section 1.9: the 2D trapezoidal rule of f over [a, b] x [c, d] with
+// n intervals in x and m in y (corner weight 1, edge 2, interior 4, times
+// dx dy / 4).
+template <typename T, typename F>
+T AplusTrapezoid2D(const F& f, double a, double b, double c, double d, int n, int m) {
+    const double dx = (b - a) / n, dy = (d - c) / m;
+    T sum{};
+    for (int i = 0; i <= m; ++i) {
+        const double wy = (i == 0 || i == m) ? 1.0 : 2.0;
+        for (int j = 0; j <= n; ++j) {
+            const double wx = (j == 0 || j == n) ? 1.0 : 2.0;
+            sum += f(a + j * dx, c + i * dy) * (wx * wy);
+        }
+    }
+    return sum * (0.25 * dx * dy);
+}
+
+struct AplusSettings {
+    AplusMapping mapping;  // default: horizon-centric (the lowest measured error)
+    int width = 32, height = 64, depth = 32;  // seed 000 2.4: (32, 256|128|64, 32)
+    int transmittance_width = 64, transmittance_height = 256;
+    // Numerics: the seed text gives n = 30 (1.10) only; K = 5 and the 6 x 12
+    // gather (30 degree steps) are the constants of the seed author's solver
+    // (atmosphere-plus repository, atmo_solver.c: ATMO_K, ATMO_GATHER_M/N_STEPS).
+    int orders = 5;                  // K
+    int transmittance_steps = 30;    // seed 000 1.10: n = 30
+    int gather_theta = 6;            // 2D trapezoid intervals over Theta in [0, pi]
+    int gather_phi = 12;             // ... over Phi in [0, 2 pi]
+    bool modified_rayleigh = false;  // seed 000 1.7
+};
+
+struct AplusTables {
+    Table scattering;                   // width x height x depth x 4: sum of orders (R, G, B, Mie)
+    Table transmittance;                // transmittance_width x transmittance_height x 1 x 3
+    std::vector<Table> orders;          // per-order tables (kept only when asked)
+    std::vector<double> order_seconds;  // precompute time of each order
+    double transmittance_seconds = 0.0;
+};
+
+// Precomputes the tables (CPU, ParallelFor). keep_orders keeps each order's table.
+AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings& settings,
+                            bool keep_orders = false);
+
+// The table's (h, mu, mu_s) of texel (x, y, z).
+void AplusTexelParameters(const AplusMapping& mapping, int x, int y, int z, int width, int height,
+                          int depth, double* h, double* mu, double* mu_s);
+
+// Samples a table laid out as the scattering table at (h, mu, mu_s): linear
+// between the two altitude rows around h, and in each row bilinear in (v, w)
+// with v computed from that row's altitude (the horizon-centric v depends on
+// h). At the ground row (h = 0) a ray below the horizon has no length:
+// `ground_row` (0 for scattering, 1 for transmittance) instead of the texel,
+// which the horizon-centric mapping gives to the horizon there (s u(0) = 0).
+ATMOS_HD inline Vec4f AplusSampleTable(const TableView& t, const AplusMapping& m, double h,
+                                       double mu, double w, const Vec4f& ground_row) {
+    int x0, z0;
+    float fx, fz;
+    TableView::Split(GetTextureCoordFromUnitRange(m.U(h), t.width), t.width, &x0, &fx);
+    TableView::Split(w, t.depth, &z0, &fz);
+    Vec4f out;
+    for (int k = 0; k < 2; ++k) {
+        const float weight = k == 0 ? 1.0f - fx : fx;
+        if (weight == 0.0f) continue;
+        const int x = Min(x0 + k, t.width - 1);
+        const double h_row = m.H(t.width > 1 ? static_cast<double>(x) / (t.width - 1) : 0.0);
+        if (h_row <= 0.0 && mu < 0.0) {
+            out = out + ground_row * weight;
+            continue;
+        }
+        int y0;
+        float fy;
+        TableView::Split(GetTextureCoordFromUnitRange(m.V(h_row, mu), t.height), t.height, &y0,
+                         &fy);
+        const auto layer = [&](int z) {
+            return (t.Fetch(x, y0, z) * (1.0f - fy) + t.Fetch(x, y0 + 1, z) * fy);
+        };
+        const Vec4f row = t.depth > 1 ? layer(z0) * (1.0f - fz) + layer(z0 + 1) * fz : layer(0);
+        out = out + row * weight;
+    }
+    return out;
+}
+ATMOS_HD inline Vec4f AplusSample(const TableView& t, const AplusMapping& m, double h, double mu,
+                                  double mu_s) {
+    return AplusSampleTable(t, m, h, mu, GetTextureCoordFromUnitRange(m.W(mu_s), t.depth), Vec4f());
+}
+ATMOS_HD inline Rgb AplusSampleTransmittance(const TableView& t, const AplusMapping& m, double h,
+                                             double mu) {
+    Vec4f one;
+    one.x = one.y = one.z = 1.0f;
+    return AplusSampleTable(t, m, h, mu, 0.5, one).rgb();
+}
+
+// The per-pixel evaluator (trivially copyable; tables by view).
+struct AtmospherePlusEvaluator {
+    AtmosphereParameters atm;
+    AplusMapping mapping;
+    TableView scattering;
+    TableView transmittance;
+    bool modified_rayleigh = false;
+
+    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                                bool want_ground) const {
+        RayResult out;
+        out.transmittance = Rgb(1.0f);
+        const AtmosphereSegment seg =
+            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
+        out.hits_ground = seg.hits_ground;
+        if (!seg.inside) return out;
+        // Seed 000 2.4: P_0 is the camera, or where the ray enters the atmosphere.
+        const Vec3d p0 = camera + dir * seg.t_start;
+        const double r = Length(p0);
+        const double h = Clamp(r - atm.bottom_radius, 0.0, atm.top_radius - atm.bottom_radius);
+        const double mu = ClampCosine(Dot(p0, dir) / r);
+        const double mu_s = ClampCosine(Dot(p0, sun) / r);
+        const double nu = ClampCosine(Dot(dir, sun));
+        const Vec4f s = AplusSample(scattering, mapping, h, mu, mu_s);
+        // Seed 000 2.3: I_S / I_I = F_R(dot(L, -V)) I_R + F_M(dot(L, -V)) I_M, with
+        // L = -sun and so dot(L, -V) = dot(sun, V) = nu.
+        const double f_r =
+            modified_rayleigh ? AplusModifiedRayleighPhase(nu) : AplusRayleighPhase(nu);
+        const double f_m = AplusMiePhase(atm.mie_phase_g, nu);
+        const Rgb sky = s.rgb() * static_cast<float>(f_r) + Rgb(s.w * static_cast<float>(f_m));
+        out.sky = Max(sky, Rgb(0.0f));
+        out.transmittance = AplusSampleTransmittance(transmittance, mapping, h, mu);
+        if (want_ground && seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0) {
+            const Vec3d g = camera + dir * seg.t_end;
+            const double cos_sun = Dot(Normalize(g), sun);
+            if (cos_sun > 0.0) {
+                const Rgb t_sun = AplusSampleTransmittance(transmittance, mapping, 0.0, cos_sun);
+                out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi)) * t_sun * out.transmittance;
+            }
+        }
+        return out;
+    }
+};
+
+// The same model without a table: the factored single scattering evaluated by
+// direct integration at the pixel's exact (h, mu, mu_s) (azimuth omitted as in
+// the table). The stand-in reference for the table error of order-1 tables
+// (tests, docs/models.md); host use only (slow).
+struct AtmospherePlusDirectEvaluator {
+    AtmosphereParameters atm;
+    int steps = 30, sun_steps = 30;
+    bool modified_rayleigh = false;
+
+    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                                bool) const {
+        RayResult out;
+        out.transmittance = Rgb(1.0f);
+        const AtmosphereSegment seg =
+            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
+        out.hits_ground = seg.hits_ground;
+        if (!seg.inside) return out;
+        const Vec3d p0 = camera + dir * seg.t_start;
+        const double r = Length(p0);
+        const double h = Clamp(r - atm.bottom_radius, 0.0, atm.top_radius - atm.bottom_radius);
+        const double nu = ClampCosine(Dot(dir, sun));
+        const AplusValue v = AplusSingleScattering(atm, h, ClampCosine(Dot(p0, dir) / r),
+                                                   ClampCosine(Dot(p0, sun) / r), steps, sun_steps);
+        const double f_r =
+            modified_rayleigh ? AplusModifiedRayleighPhase(nu) : AplusRayleighPhase(nu);
+        out.sky = Rgb(v.rayleigh * f_r + Vec3d(v.mie * AplusMiePhase(atm.mie_phase_g, nu)));
+        out.transmittance = Rgb(Exp(-OpticalDepth(atm, p0, dir, seg.t_end - seg.t_start, steps)));
+        return out;
+    }
+};
+
+// Settings from the model's options (throws atmos::Error for bad combinations).
+AplusSettings AplusSettingsFromOptions(const ModelOptions& options);
+
+class AtmospherePlusModel : public EvaluatorModel<AtmospherePlusModel> {
+  public:
+    explicit AtmospherePlusModel(const ModelOptions& options);
+    static ModelInfo StaticInfo();
+    const ModelInfo& Info() const override { return info_; }
+    void Prepare(const AtmosphereParameters& atmosphere) override;
+    AtmospherePlusEvaluator MakeEvaluator() const;
+    const AtmosphereParameters& atmosphere() const { return atm_; }
+    const AplusSettings& settings() const { return settings_; }
+    const AplusTables& tables() const { return tables_; }
+
+    // `atmos bake`: scattering.exr (W*D x H, RGBA), transmittance.exr (RGB) and
+    // atmosphere-plus.json (sizes, mapping, numerics, the atmosphere).
+    bool CanBake() const override { return true; }
+    void Bake(const std::string& directory) const override;
+    void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere) override;
+
+  private:
+    ModelInfo info_;
+    AplusSettings settings_;
+    AtmosphereParameters atm_;
+    AplusTables tables_;
+};
+
+}  // namespace atmos
