@@ -187,18 +187,27 @@ struct ReferenceEvaluator {
     // ray meets the ground), per channel; unbiased.
     //
     // With a majorant k times the extinction, the estimate's relative variance
-    // in a homogeneous medium is exp(tau / k) - 1 (Novak et al. 2014): a tight
-    // majorant (k ~ 1) is hopeless in deep shadow (tau = 14: 1e6). So the
-    // majorants are scaled by k = max(1, tau_bar), tau_bar the ray's majorant
-    // optical depth (computed exactly by walking the shells): the relative
-    // variance stays below e - 1 at a cost of ~tau_bar^2 steps, and sun rays with
-    // tau_bar <= 1 (most of them) are unchanged.
+    // in a homogeneous medium is exp(tau / k) - 1 (Novak et al. 2014), at a
+    // cost of ~k tau_bar steps: a tight majorant (k = 1) is noisy in deep shadow
+    // (tau = 14: 1e6) and still 35 % at tau = 0.3. So the majorants are scaled
+    // by k chosen from tau_bar, the ray's majorant optical depth (computed
+    // exactly by walking the shells):
+    //   tau_bar <= 1.77: k = max(1, 20 tau_bar): relative variance <= 5 %, <= 64 steps;
+    //   1.77 .. 8:       k = 64 / tau_bar:        <= e - 1, 64 steps;
+    //   > 8:             k = tau_bar:             <= e - 1, tau_bar^2 steps
+    // (only deep-shadow rays, whose transmittance is below 3e-4, cost more).
+    ATMOS_HD static double RatioTrackingScale(double tau_bar) {
+        if (tau_bar <= 1.77) return Max(1.0, 20.0 * tau_bar);
+        if (tau_bar <= 8.0) return 64.0 / tau_bar;
+        return tau_bar;
+    }
+
     ATMOS_HD Vec3d RatioTracking(Vec3d p, const Vec3d& dir, int shell, Rng& rng) const {
         const double r = Length(p);
         if (RayIntersectsGround(r, ClampCosine(Dot(p, dir) / r), atm.bottom_radius)) {
             return Vec3d(0.0);
         }
-        const double k = Max(1.0, MajorantDepth(p, dir, shell, 1e300));
+        const double k = RatioTrackingScale(MajorantDepth(p, dir, shell, 1e300));
         Vec3d t(1.0);
         for (int guard = 0; guard < 1000000; ++guard) {
             const Step step = Track(&p, dir, &shell, rng, k);
@@ -234,9 +243,12 @@ struct ReferenceEvaluator {
                             double forced_depth, double forced_length, Vec3d* sky,
                             Vec3d* ground) const {
         Vec3d w(1.0);
-        Vec3d radiance;
+        // Light found before the path first meets the ground is the sky's;
+        // once the path has met the ground before any real volume scattering,
+        // everything it gathers is light reflected by the ground.
+        Vec3d sky_radiance, ground_radiance;
+        Vec3d* radiance = &sky_radiance;
         int order = 0;
-        bool first_on_ground = false;
         const double bar = 1.0 / 3.0;
         for (int guard = 0; guard < 1000000; ++guard) {
             Step step;
@@ -264,7 +276,7 @@ struct ReferenceEvaluator {
             }
             if (step == Step::kEscaped) break;
             if (step == Step::kGround) {
-                if (order == 0) first_on_ground = true;
+                if (order == 0) radiance = &ground_radiance;
                 ++order;
                 if (max_order > 0 && order > max_order) break;
                 if (MaxComponent(atm.ground_albedo) <= 0.0) break;
@@ -272,7 +284,7 @@ struct ReferenceEvaluator {
                 const Vec3d light = SunDirection(sun, rng);
                 const double cos_sun = Dot(n, light);
                 if (cos_sun > 0.0) {
-                    radiance +=
+                    *radiance +=
                         w * atm.ground_albedo * (cos_sun / kPi) * RatioTracking(p, light, 0, rng);
                 }
                 dir = MakeDirection(n, SampleCosineHemisphereCosine(rng.Uniform()), rng.Uniform());
@@ -288,6 +300,23 @@ struct ReferenceEvaluator {
                 const double a_n = Max(Dot(w, sigma_n), 0.0) * bar;
                 const double total = a_r + a_m + a_n;
                 if (!(total > 0.0)) break;
+                // Next-event estimation at every tentative collision, with the
+                // expected value of the event choice: the light scattered here
+                // toward the camera is sigma_s(x) / sigma_bar times its phase
+                // (Rayleigh and Mie together) whether or not this collision is
+                // then taken as real; the event chosen below only decides how
+                // the path continues (its indirect light). This removes the
+                // real/null and Rayleigh/Mie coin flips from the direct light.
+                if (max_order == 0 || order < max_order) {
+                    const Vec3d light = SunDirection(sun, rng);
+                    const double nu = Dot(dir, light);
+                    const Vec3d scatter = sigma_r * RayleighPhase(nu) +
+                                          sigma_m * CornetteShanksPhase(atm.mie_phase_g, nu);
+                    if (MaxComponent(w * scatter) > 0.0) {
+                        *radiance +=
+                            w * scatter * (1.0 / sigma_bar) * RatioTracking(p, light, shell, rng);
+                    }
+                }
                 const double xi = rng.Uniform() * total;
                 if (xi >= a_r + a_m) {  // null collision: continue straight on
                     w = w * sigma_n * (1.0 / (sigma_bar * (a_n / total)));
@@ -297,12 +326,7 @@ struct ReferenceEvaluator {
                 w = w * (rayleigh ? sigma_r : sigma_m) *
                     (1.0 / (sigma_bar * ((rayleigh ? a_r : a_m) / total)));
                 ++order;
-                if (max_order > 0 && order > max_order) break;
-                const Vec3d light = SunDirection(sun, rng);
-                const double nu = Dot(dir, light);
-                const double phase =
-                    rayleigh ? RayleighPhase(nu) : CornetteShanksPhase(atm.mie_phase_g, nu);
-                radiance += w * phase * RatioTracking(p, light, shell, rng);
+                if (max_order > 0 && order >= max_order) break;  // its NEE is done
                 if (rayleigh) {
                     dir = MakeDirection(dir, SampleRayleighCosine(rng.Uniform()), rng.Uniform());
                 } else {
@@ -318,11 +342,8 @@ struct ReferenceEvaluator {
                 w = w * (1.0 / q);
             }
         }
-        if (first_on_ground) {
-            *ground += radiance;
-        } else {
-            *sky += radiance;
-        }
+        *sky += sky_radiance;
+        *ground += ground_radiance;
     }
 
     // Thesis baseline: is the sun visible from p (delta tracking in channel c)?
