@@ -204,7 +204,7 @@ Vec3d DirectPsi(const AtmosphereParameters& atm, double r, double mu_s, int kSqr
                     atm.rayleigh_scattering * d.rayleigh + atm.mie_scattering * d.mie;
                 fms += sigma_s * t * dt;
                 Vec3d tau_sun;
-                if (naive.SunOpticalDepth(p, sun, &tau_sun)) {
+                if (naive.LightDepth(p, sun, &tau_sun)) {
                     l2 += sigma_s * t * Exp(-tau_sun) * (dt * IsotropicPhase());
                 }
             }

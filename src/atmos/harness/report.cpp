@@ -8,34 +8,12 @@
 #include <sstream>
 
 #include "atmos/error.h"
+#include "harness/html.h"
 #include "harness/machine.h"
 
 namespace atmos {
 
 namespace {
-
-std::string Escape(const std::string& s) {
-    std::string out;
-    for (char c : s) {
-        switch (c) {
-            case '&':
-                out += "&amp;";
-                break;
-            case '<':
-                out += "&lt;";
-                break;
-            case '>':
-                out += "&gt;";
-                break;
-            case '"':
-                out += "&quot;";
-                break;
-            default:
-                out += c;
-        }
-    }
-    return out;
-}
 
 // printf-like "%.<digits>f" and "%.<digits>g" without a non-literal format string.
 std::string Fixed(double v, int digits) {
@@ -55,21 +33,23 @@ std::string General(double v, int digits) {
 // One metric table, best (lowest) per row highlighted, flagged cells marked.
 void MetricTable(std::ostream& f, const std::string& title, int digits, const CompareResult& r,
                  bool flip) {
-    f << "<table class=\"metric\"><caption>" << Escape(title) << "</caption>\n<tr><th>view</th>";
+    f << "<table class=\"metric\"><caption>" << HtmlEscape(title)
+      << "</caption>\n<tr><th>view</th>";
     for (size_t m = 0; m < r.models.size(); ++m) {
-        f << "<th title=\"" << Escape(r.model_titles[m]) << "\">" << Escape(r.models[m]) << "</th>";
+        f << "<th title=\"" << HtmlEscape(r.model_titles[m]) << "\">" << HtmlEscape(r.models[m])
+          << "</th>";
     }
     f << "</tr>\n";
     for (const CompareRow& row : r.rows) {
         std::vector<double> values;
         for (const CompareCell& c : row.cells) values.push_back(flip ? c.flip : c.rmse);
         const int best = BestIndex(values);
-        f << "<tr><th>" << Escape(row.label) << "</th>";
+        f << "<tr><th>" << HtmlEscape(row.label) << "</th>";
         for (size_t m = 0; m < row.cells.size(); ++m) {
             const CompareCell& c = row.cells[m];
             const bool is_best = static_cast<int>(m) == best;
             f << "<td" << (is_best ? " class=\"best\"" : "");
-            if (!c.validity_note.empty()) f << " title=\"" << Escape(c.validity_note) << "\"";
+            if (!c.validity_note.empty()) f << " title=\"" << HtmlEscape(c.validity_note) << "\"";
             f << ">" << Fixed(values[m], digits) << (c.validity_note.empty() ? "" : " &dagger;")
               << "</td>";
         }
@@ -117,7 +97,7 @@ void TimeChart(std::ostream& f, const CompareConfig& config, const CompareResult
         const int y = static_cast<int>(i) * row_h + 4;
         const double w = std::max(1.0, bar_w * b.mean_ms / max_ms);
         f << "<text x=\"" << label_w - 8 << "\" y=\"" << y + 16
-          << "\" text-anchor=\"end\" fill=\"#ddd\" font-size=\"13\">" << Escape(b.name)
+          << "\" text-anchor=\"end\" fill=\"#ddd\" font-size=\"13\">" << HtmlEscape(b.name)
           << "</text>";
         f << "<rect x=\"" << label_w << "\" y=\"" << y << "\" width=\"" << Fixed(w, 1)
           << "\" height=\"" << row_h - 8 << "\" fill=\"" << (i == 0 ? "#c96" : "#59c") << "\"/>";
@@ -125,7 +105,7 @@ void TimeChart(std::ostream& f, const CompareConfig& config, const CompareResult
         if (b.prepare_ms > 0.0) text += " + prepare " + Fixed(b.prepare_ms, 1) + " ms";
         if (b.cached) text += " (cached: the time of the original render)";
         f << "<text x=\"" << label_w + w + 6 << "\" y=\"" << y + 15
-          << "\" fill=\"#bbb\" font-size=\"12\">" << Escape(text) << "</text>\n";
+          << "\" fill=\"#bbb\" font-size=\"12\">" << HtmlEscape(text) << "</text>\n";
     }
     f << "<text x=\"" << label_w << "\" y=\"" << height - 6
       << "\" fill=\"#888\" font-size=\"12\">mean render time per view, " << config.width << "x"
@@ -143,7 +123,7 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
     const std::string title =
         std::string("atmos compare: ") + (transmittance ? "transmittance" : "radiance");
     f << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>"
-      << Escape(title) << "</title>\n<style>\n"
+      << HtmlEscape(title) << "</title>\n<style>\n"
       << "body{font-family:sans-serif;background:#111;color:#ddd;margin:1.5em}\n"
       << "h1,h2{font-weight:normal}a{color:#8cf}\n"
       << "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #444;padding:"
@@ -157,11 +137,11 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
       << "dl{display:grid;grid-template-columns:max-content auto;gap:2px 14px;font-size:13px}"
          "dt{color:#999}dd{margin:0}\n"
       << "#image-check{color:#f66}\n"
-      << "</style></head><body>\n<h1>" << Escape(title) << "</h1>\n";
+      << "</style></head><body>\n<h1>" << HtmlEscape(title) << "</h1>\n";
 
     f << "<h2>Parameters and machine</h2>\n<dl>\n";
     auto item = [&](const std::string& k, const std::string& v) {
-        f << "<dt>" << Escape(k) << "</dt><dd>" << Escape(v) << "</dd>\n";
+        f << "<dt>" << HtmlEscape(k) << "</dt><dd>" << HtmlEscape(v) << "</dd>\n";
     };
     std::string ref_opts;
     for (const auto& [k, v] : config.reference_options) {
@@ -211,31 +191,34 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
         const ModelLoc& l = r.loc[i];
         std::string files;
         for (const std::string& file : l.files) files += (files.empty() ? "" : ", ") + file;
-        f << "<tr><th>" << Escape(l.model) << (i + 1 == r.loc.size() ? " (reference)" : "")
+        f << "<tr><th>" << HtmlEscape(l.model) << (i + 1 == r.loc.size() ? " (reference)" : "")
           << "</th><td>" << l.lines << "</td><td>"
           << (l.thesis_lines >= 0 ? std::to_string(l.thesis_lines) + " (" + l.thesis_name + ")"
                                   : std::string("&ndash;"))
-          << "</td><td style=\"text-align:left\">" << Escape(files) << "</td></tr>\n";
+          << "</td><td style=\"text-align:left\">" << HtmlEscape(files) << "</td></tr>\n";
     }
     f << "</table>\n";
 
     f << "<h2>Views</h2>\n<p>Each model: its image, its FLIP error map (magma: black = no "
          "error, yellow = 1) and its absolute error (shown with the view's exposure).</p>\n";
     for (const CompareRow& row : r.rows) {
-        f << "<h3>" << Escape(row.label) << "</h3><p>" << Escape(row.description) << "</p>\n"
-          << "<div class=\"row\">\n<figure><img src=\"" << Escape(row.reference_png)
-          << "\" alt=\"reference\"><figcaption><b>reference</b> (" << Escape(config.reference_model)
-          << ")<br>" << Fixed(row.reference_seconds, 3) + " s"
+        f << "<h3>" << HtmlEscape(row.label) << "</h3><p>" << HtmlEscape(row.description)
+          << "</p>\n"
+          << "<div class=\"row\">\n<figure><img src=\"" << HtmlEscape(row.reference_png)
+          << "\" alt=\"reference\"><figcaption><b>reference</b> ("
+          << HtmlEscape(config.reference_model) << ")<br>" << Fixed(row.reference_seconds, 3) + " s"
           << (row.reference_cached ? " (cached)" : "") << "</figcaption></figure>\n";
         for (size_t m = 0; m < row.cells.size(); ++m) {
             const CompareCell& c = row.cells[m];
-            f << "<figure><img src=\"" << Escape(c.image_png) << "\" alt=\"" << Escape(r.models[m])
-              << "\"><img src=\"" << Escape(c.flip_png) << "\" alt=\"FLIP map\"><img src=\""
-              << Escape(c.rmse_png) << "\" alt=\"error\"><figcaption><b>" << Escape(r.models[m])
-              << "</b><br>FLIP " << Fixed(c.flip, 6) << ", RMSE " << General(c.rmse, 3) << "<br>"
+            f << "<figure><img src=\"" << HtmlEscape(c.image_png) << "\" alt=\""
+              << HtmlEscape(r.models[m]) << "\"><img src=\"" << HtmlEscape(c.flip_png)
+              << "\" alt=\"FLIP map\"><img src=\"" << HtmlEscape(c.rmse_png)
+              << "\" alt=\"error\"><figcaption><b>" << HtmlEscape(r.models[m]) << "</b><br>FLIP "
+              << Fixed(c.flip, 6) << ", RMSE " << General(c.rmse, 3) << "<br>"
               << Fixed(c.render_seconds, 3) + " s" << (c.cached ? " (cached)" : "");
             if (!c.validity_note.empty()) {
-                f << "<br><span class=\"flag\">&dagger; " << Escape(c.validity_note) << "</span>";
+                f << "<br><span class=\"flag\">&dagger; " << HtmlEscape(c.validity_note)
+                  << "</span>";
             }
             f << "</figcaption></figure>\n";
         }

@@ -32,6 +32,7 @@
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
+#include "physics/single_scattering.h"
 #include "render/render.h"
 
 namespace atmos {
@@ -41,9 +42,18 @@ struct NaiveEvaluator {
     int steps = 16;       // primary (view) ray samples
     int light_steps = 8;  // light ray samples
 
+    // Extinction (per channel) and the Rayleigh and Mie densities at an altitude.
+    ATMOS_HD Vec3d ExtinctionAt(double altitude, double* rho_r, double* rho_m) const {
+        const Densities d = GetDensities(atm, altitude);
+        *rho_r = d.rayleigh;
+        *rho_m = d.mie;
+        return Extinction(atm, d);
+    }
+
     // Optical depth (per channel) from `p` to the top of the atmosphere toward
-    // the sun, or false if that ray hits the ground.
-    ATMOS_HD bool SunOpticalDepth(const Vec3d& p, const Vec3d& sun, Vec3d* tau) const {
+    // the sun, by `light_steps` midpoint samples, or false if that ray hits the
+    // ground.
+    ATMOS_HD bool LightDepth(const Vec3d& p, const Vec3d& sun, Vec3d* tau) const {
         const double r = Length(p);
         const double mu_s = ClampCosine(Dot(p, sun) / r);
         if (RayIntersectsGround(r, mu_s, atm.bottom_radius)) return false;
@@ -60,48 +70,7 @@ struct NaiveEvaluator {
 
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                 bool want_ground) const {
-        RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg =
-            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
-        out.hits_ground = seg.hits_ground;
-        if (!seg.inside) {
-            if (seg.hits_ground) out.transmittance = Rgb(1.0f);  // zero-length segment
-            return out;
-        }
-        const double ds = (seg.t_end - seg.t_start) / steps;
-        const double nu = Dot(dir, sun);
-        const double phase_r = RayleighPhase(nu);
-        const double phase_m = CornetteShanksPhase(atm.mie_phase_g, nu);
-        Vec3d tau_view;  // camera to the start of the current step
-        Vec3d sum_r, sum_m;
-        for (int i = 0; i < steps; ++i) {
-            const Vec3d p = camera + dir * (seg.t_start + (i + 0.5) * ds);
-            const Densities d = GetDensities(atm, Length(p) - atm.bottom_radius);
-            const Vec3d ext = Extinction(atm, d);
-            const Vec3d tau_mid = tau_view + ext * (0.5 * ds);
-            tau_view += ext * ds;
-            Vec3d tau_sun;
-            if (!SunOpticalDepth(p, sun, &tau_sun)) continue;
-            const Vec3d t = Exp(-(tau_mid + tau_sun));
-            sum_r += t * (d.rayleigh * ds);
-            sum_m += t * (d.mie * ds);
-        }
-        const Vec3d sky =
-            atm.rayleigh_scattering * sum_r * phase_r + atm.mie_scattering * sum_m * phase_m;
-        const Vec3d t_view = Exp(-tau_view);
-        out.sky = Rgb(sky);
-        out.transmittance = Rgb(t_view);
-        if (want_ground && seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0) {
-            const Vec3d g = camera + dir * seg.t_end;
-            const Vec3d n = Normalize(g);
-            const double cos_sun = Dot(n, sun);
-            Vec3d tau_sun;
-            if (cos_sun > 0.0 && SunOpticalDepth(g, sun, &tau_sun)) {
-                out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * Exp(-tau_sun) * t_view);
-            }
-        }
-        return out;
+        return IntegrateSingleScattering(atm, *this, steps, camera, dir, sun, want_ground);
     }
 };
 

@@ -31,6 +31,7 @@
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
+#include "physics/single_scattering.h"
 #include "render/render.h"
 
 namespace atmos {
@@ -61,41 +62,7 @@ struct SchulerEvaluator {
 
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                 bool want_ground) const {
-        RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg =
-            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
-        out.hits_ground = seg.hits_ground;
-        if (!seg.inside) return out;
-        const double ds = (seg.t_end - seg.t_start) / steps;
-        const double nu = Dot(dir, sun);
-        Vec3d tau_view, sum_r, sum_m;
-        for (int i = 0; i < steps; ++i) {
-            const Vec3d p = camera + dir * (seg.t_start + (i + 0.5) * ds);
-            double rho_r, rho_m;
-            const Vec3d ext = ExtinctionAt(Length(p) - atm.bottom_radius, &rho_r, &rho_m);
-            const Vec3d tau_mid = tau_view + ext * (0.5 * ds);
-            tau_view += ext * ds;
-            Vec3d tau_sun;
-            if (!LightDepth(p, sun, &tau_sun)) continue;
-            const Vec3d t = Exp(-(tau_mid + tau_sun));
-            sum_r += t * (rho_r * ds);
-            sum_m += t * (rho_m * ds);
-        }
-        const Vec3d sky = atm.rayleigh_scattering * sum_r * RayleighPhase(nu) +
-                          atm.mie_scattering * sum_m * CornetteShanksPhase(atm.mie_phase_g, nu);
-        const Vec3d t_view = Exp(-tau_view);
-        out.sky = Rgb(sky);
-        out.transmittance = Rgb(t_view);
-        if (want_ground && seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0) {
-            const Vec3d g = camera + dir * seg.t_end;
-            const double cos_sun = Dot(Normalize(g), sun);
-            Vec3d tau_sun;
-            if (cos_sun > 0.0 && LightDepth(g, sun, &tau_sun)) {
-                out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * Exp(-tau_sun) * t_view);
-            }
-        }
-        return out;
+        return IntegrateSingleScattering(atm, *this, steps, camera, dir, sun, want_ground);
     }
 };
 

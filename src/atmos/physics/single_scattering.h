@@ -1,0 +1,68 @@
+// atmos: the single-scattering integral along a view ray, by the midpoint rule.
+//
+// Source: seed 003 section 3.2 (Eq. 8, 9) and section 5.1 (Nishita 93 as
+// formulated by Terrell 2016): for the part of the view ray inside the
+// atmosphere, `steps` equal segments sampled at their midpoints x_i,
+//   L = sum_i [ beta_R rho_R(x_i) P_R(nu) + beta_M rho_M(x_i) P_M(nu) ]
+//             T(camera, x_i) T_sun(x_i) ds,
+// with T(camera, x_i) from the extinction accumulated along the view ray to the
+// midpoint. The models that share it differ only in their medium:
+//   Vec3d ExtinctionAt(double altitude, double* rho_r, double* rho_m) const;
+//   bool LightDepth(const Vec3d& p, const Vec3d& sun, Vec3d* tau) const;
+// (LightDepth: the optical depth to the sun, false when the light ray hits the
+// ground: the planet's shadow). `naive` integrates the light ray numerically,
+// `schuler` uses the Chapman approximation.
+#pragma once
+
+#include "atmos/atmosphere.h"
+#include "atmos/math.h"
+#include "physics/geometry.h"
+#include "physics/phase.h"
+#include "render/render.h"
+
+namespace atmos {
+
+template <typename Medium>
+ATMOS_HD inline RayResult IntegrateSingleScattering(const AtmosphereParameters& atm,
+                                                    const Medium& medium, int steps,
+                                                    const Vec3d& camera, const Vec3d& dir,
+                                                    const Vec3d& sun, bool want_ground) {
+    RayResult out;
+    out.transmittance = Rgb(1.0f);
+    const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
+    out.hits_ground = seg.hits_ground;
+    if (!seg.inside) return out;
+    const double ds = (seg.t_end - seg.t_start) / steps;
+    const double nu = Dot(dir, sun);
+    Vec3d tau_view;  // camera to the start of the current step
+    Vec3d sum_r, sum_m;
+    for (int i = 0; i < steps; ++i) {
+        const Vec3d p = camera + dir * (seg.t_start + (i + 0.5) * ds);
+        double rho_r, rho_m;
+        const Vec3d ext = medium.ExtinctionAt(Length(p) - atm.bottom_radius, &rho_r, &rho_m);
+        const Vec3d tau_mid = tau_view + ext * (0.5 * ds);
+        tau_view += ext * ds;
+        Vec3d tau_sun;
+        if (!medium.LightDepth(p, sun, &tau_sun)) continue;
+        const Vec3d t = Exp(-(tau_mid + tau_sun));
+        sum_r += t * (rho_r * ds);
+        sum_m += t * (rho_m * ds);
+    }
+    const Vec3d sky = atm.rayleigh_scattering * sum_r * RayleighPhase(nu) +
+                      atm.mie_scattering * sum_m * CornetteShanksPhase(atm.mie_phase_g, nu);
+    const Vec3d t_view = Exp(-tau_view);
+    out.sky = Rgb(sky);
+    out.transmittance = Rgb(t_view);
+    // The ground (albedo a) lit by the direct sun only: a / pi max(0, n.s) T_sun T_view.
+    if (want_ground && seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0) {
+        const Vec3d g = camera + dir * seg.t_end;
+        const double cos_sun = Dot(Normalize(g), sun);
+        Vec3d tau_sun;
+        if (cos_sun > 0.0 && medium.LightDepth(g, sun, &tau_sun)) {
+            out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * Exp(-tau_sun) * t_view);
+        }
+    }
+    return out;
+}
+
+}  // namespace atmos
