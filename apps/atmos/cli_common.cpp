@@ -16,6 +16,7 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_flag("--quiet,-q", o->quiet, "no progress bar or timing lines");
+    AddBackendOption(cmd, &o->backend);
     cmd->add_option("--load", o->load,
                     "read the model's tables from a directory written by `atmos bake` instead of "
                     "precomputing them");
@@ -30,6 +31,13 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
                     ->group("Model options");
         }
     }
+}
+
+void AddBackendOption(CLI::App* cmd, std::string* backend) {
+    cmd->add_option("--backend", *backend,
+                    "where pixels are computed: cpu, or cuda (a build with -DATMOS_CUDA=ON and a "
+                    "CUDA device)")
+        ->capture_default_str();
 }
 
 std::map<std::string, std::string> GivenModelOptions(const CommonOptions& o) {

@@ -88,6 +88,7 @@ std::vector<SampleQuery> ReadQueries(std::istream& in) {
 
 int CmdSample(const CommonOptions& common) {
     ThreadLimit limit(common.threads);
+    const BackendScope backend(ParseBackend(common.backend));
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(common.model, GivenModelOptions(common));
     const std::vector<SampleQuery> queries = ReadQueries(std::cin);
