@@ -16,7 +16,6 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_flag("--quiet,-q", o->quiet, "no progress bar or timing lines");
-    AddBackendOption(cmd, &o->backend);
     cmd->add_option("--load", o->load,
                     "read the model's tables from a directory written by `atmos bake` instead of "
                     "precomputing them");

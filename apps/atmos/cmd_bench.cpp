@@ -111,7 +111,8 @@ int CmdBench(const BenchOptions& o) {
                 if (timing.milliseconds.empty()) {
                     Fail("model ", name, " did not render through the device loop");
                 }
-                for (float ms : timing.milliseconds) times.push_back(1e-3 * static_cast<double>(ms));
+                for (float ms : timing.milliseconds)
+                    times.push_back(1e-3 * static_cast<double>(ms));
             } else {
                 for (int i = 0; i < warmup; ++i) model->Render(request, &image);
                 for (int i = 0; i < repeat; ++i) {

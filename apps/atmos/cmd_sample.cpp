@@ -115,6 +115,7 @@ Command AddSampleCommand(CLI::App* root) {
     c.app = root->add_subcommand(
         "sample", "evaluate a model at queries read as CSV from stdin, answers to stdout");
     AddCommonOptions(c.app, common.get());
+    AddBackendOption(c.app, &common->backend);
     c.run = [common] { return CmdSample(*common); };
     return c;
 }
