@@ -12,6 +12,7 @@
 #include <string>
 
 #include "atmos/image.h"
+#include "base/parallel.h"
 
 namespace fs = std::filesystem;
 
@@ -158,6 +159,33 @@ TEST(Cli, ErrorPaths) {
     const fs::path bad_json = TempDir() / "bad.json";
     std::ofstream(bad_json) << "{ \"bottom_radius\": 6360e3, ";
     ExpectError("render --atmosphere " + bad_json.string() + o, "bad.json");
+}
+
+// --backend: a bad name is an error; cuda is one clear error where it cannot
+// run (no CUDA in the build, or no device), and renders where it can.
+TEST(Cli, BackendOption) {
+    const std::string o = " -o " + (TempDir() / "backend.exr").string();
+    ExpectError("render --view ground-noon --size 8x4 --backend gpu" + o, "unknown backend 'gpu'");
+    if (!atmos::HasCudaSupport()) {
+        const std::string no_cuda =
+            "this build has no CUDA support; configure with -DATMOS_CUDA=ON";
+        ExpectError("render --view ground-noon --size 8x4 --backend cuda" + o, no_cuda);
+        ExpectError("sample --backend cuda", no_cuda, "altitude_m,mu,mu_s,azimuth_deg\n0,1,1,0\n");
+        ExpectError("bench --models empty --views ground-noon --size 8x4 --backend cuda -o " +
+                        (TempDir() / "backend.csv").string(),
+                    no_cuda);
+        ExpectError(
+            "compare --models empty --views ground-noon --size 8x4 --no-cache --backend "
+            "cuda -o " +
+                (TempDir() / "backend_compare").string(),
+            no_cuda);
+        return;
+    }
+    const Result r = RunAtmos("render --view ground-noon --size 8x4 -q --backend cuda" + o);
+    if (r.status != 0) {
+        EXPECT_NE(r.err.find("cudaGetDeviceCount returned"), std::string::npos) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    }
 }
 
 TEST(Cli, Help) {

@@ -32,6 +32,13 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
     }
 }
 
+void AddBackendOption(CLI::App* cmd, std::string* backend) {
+    cmd->add_option("--backend", *backend,
+                    "where pixels are computed: cpu, or cuda (a build with -DATMOS_CUDA=ON and a "
+                    "CUDA device)")
+        ->capture_default_str();
+}
+
 std::map<std::string, std::string> GivenModelOptions(const CommonOptions& o) {
     std::map<std::string, std::string> given;
     for (const auto& [name, flag] : o.model_option_flags) {

@@ -24,6 +24,7 @@ struct CommonOptions {
     std::string atmosphere = "earth";
     std::vector<std::string> sets;
     int threads = 0;
+    std::string backend = "cpu";  // --backend cpu|cuda (base/parallel.h)
     bool quiet = false;
     std::string load;  // --load DIR: read baked tables instead of Prepare()
     // Model options: every option of every model is declared (so --help lists
@@ -33,6 +34,10 @@ struct CommonOptions {
 };
 
 void AddCommonOptions(CLI::App* cmd, CommonOptions* o);
+// --backend cpu|cuda: where the per-pixel loops run (render, sample, compare,
+// bench). The command selects it with a BackendScope (base/parallel.h), which
+// fails with one clear error when CUDA is not built in or no device is present.
+void AddBackendOption(CLI::App* cmd, std::string* backend);
 // The model options given on the command line (name -> text).
 std::map<std::string, std::string> GivenModelOptions(const CommonOptions& o);
 // "WxH" with 1 <= W, H <= 16384; throws atmos::Error otherwise.

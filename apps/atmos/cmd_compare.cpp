@@ -36,6 +36,7 @@ struct CompareCliOptions {
     bool no_npy = false;
     bool quiet = false;
     int threads = 0;
+    std::string backend = "cpu";
     double ppd = 0.0;
     std::string tone_mapper = "aces";
     std::string command_line;
@@ -68,7 +69,8 @@ int CmdCompare(const CompareCliOptions& o) {
     config.output_dir = !o.output.empty()                             ? o.output
                         : config.quantity == Quantity::kTransmittance ? "out/transmittance"
                                                                       : "out";
-    config.cache_dir = o.no_cache ? "" : o.cache;
+    // CUDA images may differ from CPU ones in the last bits: their own cache.
+    config.cache_dir = o.no_cache ? "" : o.backend == "cuda" ? o.cache + "/cuda" : o.cache;
     config.write_npy = !o.no_npy;
     config.show_progress = !o.quiet;
     config.flip.ppd = o.ppd;
@@ -107,6 +109,7 @@ int CmdCompare(const CompareCliOptions& o) {
     CreateModel(config.reference_model, config.reference_options);  // validate the options
 
     ThreadLimit limit(o.threads);
+    const BackendScope backend(ParseBackend(o.backend));
     const CompareResult r = RunCompare(config);
     if (!o.quiet) {
         std::fprintf(stderr, "compared %zu models at %zu views in %.1f s (%d threads)\n",
@@ -159,6 +162,7 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_flag("--quiet,-q", o->quiet, "no progress lines");
+    AddBackendOption(cmd, &o->backend);
     Command c;
     c.app = cmd;
     c.run = [o] { return CmdCompare(*o); };

@@ -50,6 +50,7 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     }
 
     ThreadLimit limit(common.threads);
+    const BackendScope backend(ParseBackend(common.backend));
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(common.model, GivenModelOptions(common));
     std::vector<View> views;
@@ -131,6 +132,7 @@ Command AddRenderCommand(CLI::App* root) {
     Command c;
     CLI::App* render = root->add_subcommand("render", "render one view (or all) with one model");
     AddCommonOptions(render, common.get());
+    AddBackendOption(render, &common->backend);
     render->add_option("--view,-v", ro->view, "view name, or 'all' (-o is then a directory)")
         ->capture_default_str();
     render->add_option("--size,-s", ro->size, "image size WIDTHxHEIGHT")->capture_default_str();

@@ -88,6 +88,7 @@ std::vector<SampleQuery> ReadQueries(std::istream& in) {
 
 int CmdSample(const CommonOptions& common) {
     ThreadLimit limit(common.threads);
+    const BackendScope backend(ParseBackend(common.backend));
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(common.model, GivenModelOptions(common));
     const std::vector<SampleQuery> queries = ReadQueries(std::cin);
@@ -114,6 +115,7 @@ Command AddSampleCommand(CLI::App* root) {
     c.app = root->add_subcommand(
         "sample", "evaluate a model at queries read as CSV from stdin, answers to stdout");
     AddCommonOptions(c.app, common.get());
+    AddBackendOption(c.app, &common->backend);
     c.run = [common] { return CmdSample(*common); };
     return c;
 }

@@ -5,6 +5,13 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <atomic>
+
+#include "atmos/error.h"
+#if defined(ATMOS_HAS_CUDA)
+#include "cuda/runtime.h"
+#endif
+
 namespace atmos {
 
 ThreadLimit::ThreadLimit(int threads) {
@@ -43,5 +50,47 @@ void ParallelForTiles(int width, int height, int tile,
              y0 + tile < height ? y0 + tile : height);
     });
 }
+
+namespace {
+std::atomic<Backend> g_backend{Backend::kCpu};
+std::atomic<DeviceTimingRequest*> g_device_timing{nullptr};
+}  // namespace
+
+Backend ParseBackend(const std::string& text) {
+    if (text == "cpu") return Backend::kCpu;
+    if (text == "cuda") return Backend::kCuda;
+    Fail("unknown backend '", text, "': expected cpu or cuda");
+}
+
+const char* BackendName(Backend backend) { return backend == Backend::kCuda ? "cuda" : "cpu"; }
+
+bool HasCudaSupport() {
+#if defined(ATMOS_HAS_CUDA)
+    return true;
+#else
+    return false;
+#endif
+}
+
+void CheckBackendAvailable(Backend backend) {
+    if (backend == Backend::kCpu) return;
+#if defined(ATMOS_HAS_CUDA)
+    cuda::RequireDevice();
+#else
+    Fail("--backend cuda: this build has no CUDA support; configure with -DATMOS_CUDA=ON");
+#endif
+}
+
+BackendScope::BackendScope(Backend backend) : previous_(g_backend.load()) {
+    CheckBackendAvailable(backend);
+    g_backend.store(backend);
+}
+BackendScope::~BackendScope() { g_backend.store(previous_); }
+Backend CurrentBackend() { return g_backend.load(); }
+
+DeviceTimingScope::DeviceTimingScope(DeviceTimingRequest* request)
+    : previous_(g_device_timing.exchange(request)) {}
+DeviceTimingScope::~DeviceTimingScope() { g_device_timing.store(previous_); }
+DeviceTimingRequest* CurrentDeviceTiming() { return g_device_timing.load(); }
 
 }  // namespace atmos

@@ -1,11 +1,20 @@
-// atmos: the one ParallelFor of the project (CPU backend: oneTBB).
+// atmos: the one ParallelFor of the project (CPU backend: oneTBB), and the
+// choice of backend for the per-pixel loops.
 //
 // Work is split into independent items; results must not depend on the
 // schedule, so a render is bit-identical for any thread count.
+//
+// Backend: the per-pixel loops (RenderImage and SampleAll in render/render.h)
+// run on the CPU (ParallelFor, the default) or, in a build with CUDA
+// (ATMOS_CUDA, which defines ATMOS_HAS_CUDA), as CUDA kernels over the same
+// ShadePixel(). The choice is made here, once per process (BackendScope), and
+// read only by those two loops; precomputation always runs on the CPU.
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <string>
+#include <vector>
 
 namespace atmos {
 
@@ -32,5 +41,54 @@ void ParallelFor(int64_t count, int64_t grain, const std::function<void(int64_t)
 // body(x0, y0, x1, y1) for each tile (half-open), in parallel.
 void ParallelForTiles(int width, int height, int tile,
                       const std::function<void(int, int, int, int)>& body);
+
+enum class Backend { kCpu, kCuda };
+
+// "cpu" | "cuda"; throws atmos::Error otherwise.
+Backend ParseBackend(const std::string& text);
+const char* BackendName(Backend backend);
+// True when this build was configured with CUDA (ATMOS_CUDA).
+bool HasCudaSupport();
+// Throws one clear atmos::Error when `backend` cannot run here: a build
+// without CUDA, or no usable CUDA device (naming what cudaGetDeviceCount
+// returned).
+void CheckBackendAvailable(Backend backend);
+
+// Selects the backend of the per-pixel loops for the lifetime of the guard
+// (checked with CheckBackendAvailable first). Process-wide; nested guards:
+// the innermost wins.
+class BackendScope {
+  public:
+    explicit BackendScope(Backend backend);
+    ~BackendScope();
+    BackendScope(const BackendScope&) = delete;
+    BackendScope& operator=(const BackendScope&) = delete;
+
+  private:
+    Backend previous_;
+};
+Backend CurrentBackend();
+
+// Kernel timing on the CUDA backend (`atmos bench --backend cuda`): while a
+// request is installed, every device render launches its kernel `warmup`
+// times untimed, then `repeats` times, each between two CUDA events, and
+// stores the per-launch milliseconds in `milliseconds` (uploads and copies
+// excluded). Ignored by the CPU backend.
+struct DeviceTimingRequest {
+    int warmup = 16;
+    int repeats = 256;
+    std::vector<float> milliseconds;
+};
+class DeviceTimingScope {
+  public:
+    explicit DeviceTimingScope(DeviceTimingRequest* request);
+    ~DeviceTimingScope();
+    DeviceTimingScope(const DeviceTimingScope&) = delete;
+    DeviceTimingScope& operator=(const DeviceTimingScope&) = delete;
+
+  private:
+    DeviceTimingRequest* previous_;
+};
+DeviceTimingRequest* CurrentDeviceTiming();
 
 }  // namespace atmos

@@ -2,18 +2,27 @@
 //
 // Compiled by nvcc from the same headers as the CPU build (render/render.h and
 // the models' evaluators); built for the architectures of ATMOS_CUDA_ARCHITECTURES.
+// RenderImageDevice / SampleAllDevice are the CUDA side of RenderImage and
+// SampleAll (render/render.h), instantiated for every evaluator of
+// render/device_evaluators.h.
 #include <cuda_runtime.h>
 
-#include "models/bruneton.h"
+#include <algorithm>
+#include <vector>
+
+#include "cuda/device_buffer.h"
+#include "cuda/device_upload.h"
+
 #include "models/atmosphere_plus.h"
+#include "models/bruneton.h"
 #include "models/empty.h"
 #include "models/flat.h"
 #include "models/hillaire.h"
 #include "models/naive.h"
-#include "models/reference.h"
 #include "models/oneil.h"
 #include "models/preetham.h"
 #include "models/raymarched.h"
+#include "models/reference.h"
 #include "models/schuler.h"
 #include "models/transmittance_chapman.h"
 #include "models/transmittance_erfc.h"
@@ -34,57 +43,77 @@ __global__ void RenderKernel(Evaluator evaluator, PixelSetup setup, ImageView ou
     out.Set(x, y, ShadePixel(evaluator, setup, x, y));
 }
 
-// Renders into device memory `device_pixels` (width * height * 3 floats).
-// Returns the CUDA error of the launch.
 template <typename Evaluator>
-cudaError_t LaunchRender(const Evaluator& evaluator, const PixelSetup& setup, float* device_pixels,
-                         cudaStream_t stream) {
-    const dim3 block(16, 16);
-    const dim3 grid((setup.width + block.x - 1) / block.x, (setup.height + block.y - 1) / block.y);
-    ImageView view{device_pixels, setup.width, setup.height};
-    RenderKernel<<<grid, block, 0, stream>>>(evaluator, setup, view);
-    return cudaGetLastError();
+__global__ void SampleKernel(Evaluator evaluator, double bottom_radius, const SampleQuery* queries,
+                             size_t count, SampleAnswer* answers) {
+    const size_t i = static_cast<size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= count) return;
+    answers[i] = SampleOne(evaluator, bottom_radius, queries[i], static_cast<uint64_t>(i));
 }
 
-template cudaError_t LaunchRender<EmptyEvaluator>(const EmptyEvaluator&, const PixelSetup&, float*,
-                                                  cudaStream_t);
-template cudaError_t LaunchRender<ReferenceEvaluator>(const ReferenceEvaluator&, const PixelSetup&,
-                                                      float*, cudaStream_t);
-template cudaError_t LaunchRender<NaiveEvaluator>(const NaiveEvaluator&, const PixelSetup&, float*,
-                                                  cudaStream_t);
-template cudaError_t LaunchRender<HillaireEvaluator>(const HillaireEvaluator&, const PixelSetup&,
-                                                     float*, cudaStream_t);
+template <typename Evaluator>
+void RenderImageDevice(const Evaluator& evaluator, const PixelSetup& setup, ImageView out) {
+    if (setup.width <= 0 || setup.height <= 0) return;
+    DeviceTables tables;
+    const Evaluator device_evaluator = ToDevice(evaluator, &tables);
+    const size_t bytes = static_cast<size_t>(setup.width) * setup.height * 3 * sizeof(float);
+    DeviceBuffer pixels(bytes);
+    const ImageView view{static_cast<float*>(pixels.data()), setup.width, setup.height};
+    const dim3 block(16, 16);
+    const dim3 grid((setup.width + block.x - 1) / block.x, (setup.height + block.y - 1) / block.y);
+    auto launch = [&]() {
+        RenderKernel<<<grid, block>>>(device_evaluator, setup, view);
+        Check(cudaGetLastError(), "render kernel launch");
+    };
+    DeviceTimingRequest* timing = CurrentDeviceTiming();
+    if (timing && timing->repeats > 0) {
+        // Kernel time only, between CUDA events (tables and pixels stay resident).
+        for (int i = 0; i < timing->warmup; ++i) launch();
+        cudaEvent_t start, stop;
+        Check(cudaEventCreate(&start), "cudaEventCreate");
+        Check(cudaEventCreate(&stop), "cudaEventCreate");
+        timing->milliseconds.clear();
+        for (int i = 0; i < timing->repeats; ++i) {
+            Check(cudaEventRecord(start), "cudaEventRecord");
+            launch();
+            Check(cudaEventRecord(stop), "cudaEventRecord");
+            Check(cudaEventSynchronize(stop), "cudaEventSynchronize");
+            float ms = 0.0f;
+            Check(cudaEventElapsedTime(&ms, start, stop), "cudaEventElapsedTime");
+            timing->milliseconds.push_back(ms);
+        }
+        cudaEventDestroy(start);
+        cudaEventDestroy(stop);
+    }
+    launch();
+    Check(cudaDeviceSynchronize(), "render kernel");
+    pixels.CopyToHost(out.data, bytes);
+}
 
-template cudaError_t LaunchRender<FlatEvaluator>(const FlatEvaluator&, const PixelSetup&, float*,
-                                                 cudaStream_t);
-template cudaError_t LaunchRender<RaymarchedEvaluator>(const RaymarchedEvaluator&,
-                                                       const PixelSetup&, float*, cudaStream_t);
-template cudaError_t LaunchRender<SchulerEvaluator>(const SchulerEvaluator&, const PixelSetup&,
-                                                    float*, cudaStream_t);
-template cudaError_t LaunchRender<OneilEvaluator>(const OneilEvaluator&, const PixelSetup&, float*,
-                                                  cudaStream_t);
-template cudaError_t LaunchRender<PreethamEvaluator>(const PreethamEvaluator&, const PixelSetup&,
-                                                     float*, cudaStream_t);
-template cudaError_t LaunchRender<TransmittanceEvaluator<ReferenceTransmittanceOptics>>(
-    const TransmittanceEvaluator<ReferenceTransmittanceOptics>&, const PixelSetup&, float*,
-    cudaStream_t);
-template cudaError_t LaunchRender<TransmittanceEvaluator<FlatOptics>>(
-    const TransmittanceEvaluator<FlatOptics>&, const PixelSetup&, float*, cudaStream_t);
-template cudaError_t LaunchRender<TransmittanceEvaluator<ErfcTransmittanceOptics>>(
-    const TransmittanceEvaluator<ErfcTransmittanceOptics>&, const PixelSetup&, float*,
-    cudaStream_t);
-template cudaError_t LaunchRender<TransmittanceEvaluator<ChapmanTransmittanceOptics>>(
-    const TransmittanceEvaluator<ChapmanTransmittanceOptics>&, const PixelSetup&, float*,
-    cudaStream_t);
-template cudaError_t LaunchRender<TransmittanceEvaluator<OneilOptics>>(
-    const TransmittanceEvaluator<OneilOptics>&, const PixelSetup&, float*, cudaStream_t);
-template cudaError_t LaunchRender<TransmittanceEvaluator<PolynomialTransmittanceOptics>>(
-    const TransmittanceEvaluator<PolynomialTransmittanceOptics>&, const PixelSetup&, float*,
-    cudaStream_t);
-template cudaError_t LaunchRender<BrunetonEvaluator>(const BrunetonEvaluator&, const PixelSetup&,
-                                                     float*, cudaStream_t);
-template cudaError_t LaunchRender<AtmospherePlusEvaluator>(const AtmospherePlusEvaluator&,
-                                                           const PixelSetup&, float*, cudaStream_t);
+template <typename Evaluator>
+void SampleAllDevice(const Evaluator& evaluator, double bottom_radius, const SampleQuery* queries,
+                     size_t count, SampleAnswer* answers) {
+    if (count == 0) return;
+    DeviceTables tables;
+    const Evaluator device_evaluator = ToDevice(evaluator, &tables);
+    DeviceBuffer device_queries(count * sizeof(SampleQuery));
+    device_queries.CopyFromHost(queries, count * sizeof(SampleQuery));
+    DeviceBuffer device_answers(count * sizeof(SampleAnswer));
+    const unsigned block = 128;
+    const unsigned grid = static_cast<unsigned>((count + block - 1) / block);
+    SampleKernel<<<grid, block>>>(device_evaluator, bottom_radius,
+                                  static_cast<const SampleQuery*>(device_queries.data()), count,
+                                  static_cast<SampleAnswer*>(device_answers.data()));
+    Check(cudaGetLastError(), "sample kernel launch");
+    Check(cudaDeviceSynchronize(), "sample kernel");
+    device_answers.CopyToHost(answers, count * sizeof(SampleAnswer));
+}
+
+#define ATMOS_INSTANTIATE_DEVICE(E)                                             \
+    template void RenderImageDevice<E>(const E&, const PixelSetup&, ImageView); \
+    template void SampleAllDevice<E>(const E&, double, const SampleQuery*, size_t, SampleAnswer*);
+ATMOS_DEVICE_EVALUATORS(ATMOS_INSTANTIATE_DEVICE)
+#undef ATMOS_INSTANTIATE_DEVICE
 
 }  // namespace cuda
 }  // namespace atmos

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "atmos/error.h"
+
 namespace atmos {
 
 PixelSetup MakePixelSetup(const RenderRequest& request, const AtmosphereParameters& atmosphere) {
@@ -17,6 +19,15 @@ PixelSetup MakePixelSetup(const RenderRequest& request, const AtmosphereParamete
     s.cos_sun_radius = std::cos(alpha);
     s.sun_disc_scale = static_cast<float>(1.0 / (kPi * alpha * alpha));
     return s;
+}
+
+void FailNoDeviceKernels(bool has_cuda) {
+    if (!has_cuda) {
+        Fail("--backend cuda: this build has no CUDA support; configure with -DATMOS_CUDA=ON");
+    }
+    Fail(
+        "--backend cuda: this model's evaluator has no CUDA kernels (add it to "
+        "src/atmos/render/device_evaluators.h)");
 }
 
 }  // namespace atmos

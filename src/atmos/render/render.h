@@ -32,6 +32,7 @@
 #include "base/parallel.h"
 #include "base/progress.h"
 #include "physics/geometry.h"
+#include "render/device_evaluators.h"
 
 namespace atmos {
 
@@ -91,13 +92,45 @@ ATMOS_HD inline Rgb ShadePixel(const Evaluator& evaluator, const PixelSetup& s, 
     return SanitizeRadiance(radiance);
 }
 
-// Renders every pixel of `out` (already sized s.width x s.height) on the CPU:
-// 16 x 16 tiles in parallel; each pixel depends on its coordinates only, so the
-// image is the same for any thread count.
+#if defined(ATMOS_HAS_CUDA)
+namespace cuda {
+// Defined (and instantiated for ATMOS_DEVICE_EVALUATORS) in
+// src/atmos/cuda/render_kernels.cu. Both copy the evaluator's tables to the
+// device, run the kernel and copy the result back; throw atmos::Error on a
+// CUDA error.
+template <typename Evaluator>
+void RenderImageDevice(const Evaluator& evaluator, const PixelSetup& setup, ImageView out);
+template <typename Evaluator>
+void SampleAllDevice(const Evaluator& evaluator, double bottom_radius, const SampleQuery* queries,
+                     size_t count, SampleAnswer* answers);
+}  // namespace cuda
+#endif
+
+// Throws the error of a device loop that cannot run: no CUDA in this build, or
+// an evaluator without kernels (render/render.cpp).
+[[noreturn]] void FailNoDeviceKernels(bool has_cuda);
+
+// Renders every pixel of `out` (already sized s.width x s.height): on the CPU
+// (the default), 16 x 16 tiles in parallel; each pixel depends on its
+// coordinates only, so the image is the same for any thread count. On the
+// CUDA backend, one thread per pixel on the device.
 // `progress` (may be null) is advanced by one per pixel.
 template <typename Evaluator>
 void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView out,
                  Progress* progress) {
+    if (CurrentBackend() == Backend::kCuda) {
+#if defined(ATMOS_HAS_CUDA)
+        if constexpr (HasDeviceKernels<Evaluator>::value) {
+            cuda::RenderImageDevice(evaluator, setup, out);
+            if (progress) progress->Add(static_cast<int64_t>(setup.width) * setup.height);
+            return;
+        } else {
+            FailNoDeviceKernels(true);
+        }
+#else
+        FailNoDeviceKernels(false);
+#endif
+    }
     constexpr int kTile = 16;
     ParallelForTiles(setup.width, setup.height, kTile, [&](int x0, int y0, int x1, int y1) {
         for (int y = y0; y < y1; ++y) {
@@ -135,6 +168,19 @@ template <typename Evaluator>
 std::vector<SampleAnswer> SampleAll(const Evaluator& evaluator, double bottom_radius,
                                     const std::vector<SampleQuery>& queries) {
     std::vector<SampleAnswer> answers(queries.size());
+    if (CurrentBackend() == Backend::kCuda) {
+#if defined(ATMOS_HAS_CUDA)
+        if constexpr (HasDeviceKernels<Evaluator>::value) {
+            cuda::SampleAllDevice(evaluator, bottom_radius, queries.data(), queries.size(),
+                                  answers.data());
+            return answers;
+        } else {
+            FailNoDeviceKernels(true);
+        }
+#else
+        FailNoDeviceKernels(false);
+#endif
+    }
     ParallelFor(static_cast<int64_t>(queries.size()), 64, [&](int64_t i) {
         answers[static_cast<size_t>(i)] = SampleOne(
             evaluator, bottom_radius, queries[static_cast<size_t>(i)], static_cast<uint64_t>(i));
