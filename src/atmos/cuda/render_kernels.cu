@@ -10,6 +10,7 @@
 #include "models/flat.h"
 #include "models/hillaire.h"
 #include "models/naive.h"
+#include "models/neural.h"
 #include "models/reference.h"
 #include "models/oneil.h"
 #include "models/preetham.h"
@@ -85,6 +86,8 @@ template cudaError_t LaunchRender<BrunetonEvaluator>(const BrunetonEvaluator&, c
                                                      float*, cudaStream_t);
 template cudaError_t LaunchRender<AtmospherePlusEvaluator>(const AtmospherePlusEvaluator&,
                                                            const PixelSetup&, float*, cudaStream_t);
+template cudaError_t LaunchRender<NeuralEvaluator>(const NeuralEvaluator&, const PixelSetup&,
+                                                   float*, cudaStream_t);
 
 }  // namespace cuda
 }  // namespace atmos
