@@ -33,14 +33,13 @@ struct FitOptions {
 
 int CmdFit(const FitOptions& o) {
     if (o.model != "neural") Fail("fit: only --model neural can be fitted, got '", o.model, "'");
-    if (o.reference != "bruneton" && o.reference != "reference") {
-        Fail("fit: --reference must be bruneton or reference, got '", o.reference, "'");
-    }
+    if (o.reference == o.model) Fail("fit: --reference cannot be the model being fitted");
     if (o.output.empty()) Fail("fit: -o FILE.json is required");
     ThreadLimit limit(o.threads);
     const AtmosphereParameters atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
     std::map<std::string, std::string> ref_options;
     if (o.reference == "reference") ref_options["spp"] = std::to_string(o.reference_spp);
+    // CreateModel rejects an unknown name with one clear error.
     std::unique_ptr<Model> reference = CreateModel(o.reference, ref_options);
     const auto t0 = std::chrono::steady_clock::now();
     reference->Prepare(atmosphere);
