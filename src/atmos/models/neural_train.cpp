@@ -174,13 +174,15 @@ void Train(Mlp* net, const DataSet& train, int steps, const NeuralFitOptions& o,
             loss_count = 0;
         }
         const double t = step + 1.0;
+        const double lr = o.learning_rate * std::pow(o.final_learning_rate / o.learning_rate,
+                                                     step / std::max(1.0, steps - 1.0));
         const double c1 = 1.0 - std::pow(beta1, t), c2 = 1.0 - std::pow(beta2, t);
         auto update = [&](std::vector<double>& p, std::vector<double>& g, std::vector<double>& m,
                           std::vector<double>& v) {
             for (size_t k = 0; k < p.size(); ++k) {
                 m[k] = beta1 * m[k] + (1.0 - beta1) * g[k];
                 v[k] = beta2 * v[k] + (1.0 - beta2) * g[k] * g[k];
-                p[k] -= o.learning_rate * (m[k] / c1) / (std::sqrt(v[k] / c2) + adam_eps);
+                p[k] -= lr * (m[k] / c1) / (std::sqrt(v[k] / c2) + adam_eps);
             }
         };
         update(net->w, gw, mw, vw);
@@ -260,6 +262,9 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     if (o.transmittance_samples < 10 || o.scattering_samples < 10) Fail("fit: too few samples");
     if (o.transmittance_steps < 1 || o.scattering_steps < 1 || o.batch < 1) {
         Fail("fit: steps and batch must be >= 1");
+    }
+    if (!(o.learning_rate > 0.0 && o.final_learning_rate > 0.0)) {
+        Fail("fit: learning rates must be > 0");
     }
     if (!(o.holdout >= 0.0 && o.holdout < 0.9)) Fail("fit: holdout must be in [0, 0.9)");
     const bool large = o.network == "large";
@@ -371,6 +376,7 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     tj["scattering_steps"] = o.scattering_steps;
     tj["batch"] = o.batch;
     tj["learning_rate"] = o.learning_rate;
+    tj["final_learning_rate"] = o.final_learning_rate;
     tj["seed"] = o.seed;
     tj["holdout"] = o.holdout;
     tj["loss"] = "mean squared ln((y_hat + 1e-4) / (y + 1e-4))";

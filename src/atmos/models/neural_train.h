@@ -35,6 +35,9 @@ struct NeuralFitOptions {
     int scattering_steps = 8000;
     int batch = 128;
     double learning_rate = 0.01;  // seed 003 section 9.6
+    // Beyond the thesis: the step size decays exponentially from
+    // learning_rate to final_learning_rate over the steps (equal: constant).
+    double final_learning_rate = 0.01;
     double holdout = 0.1;         // fraction of samples held out
     uint64_t seed = 1;
 };
