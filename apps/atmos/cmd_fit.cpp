@@ -109,9 +109,10 @@ Command AddFitCommand(CLI::App* root) {
     c.app->add_option("--batch", o->fit.batch, "mini-batch size")->capture_default_str();
     c.app->add_option("--learning-rate", o->fit.learning_rate, "Adam step size")
         ->capture_default_str();
-    c.app->add_option("--final-learning-rate", o->fit.final_learning_rate,
-                      "step size at the last step (exponential decay; equal to --learning-rate: "
-                      "constant, as the thesis)")
+    c.app
+        ->add_option("--final-learning-rate", o->fit.final_learning_rate,
+                     "step size at the last step (exponential decay; equal to --learning-rate: "
+                     "constant, as the thesis)")
         ->capture_default_str();
     c.app->add_option("--holdout", o->fit.holdout, "fraction of samples held out")
         ->capture_default_str();

@@ -14,7 +14,11 @@
 //  - a ray that leaves through the top: T = T(h_v, mu_v), S = S(h_v, mu_v, ...);
 //  - a ray that meets the ground at g is reversed for the transmittance
 //    (section 9.6.3): T = T(g, -v) / T(camera, -v) (Eq. 43), and
-//    S = S(camera, v) - S(g, v) T (Eq. 44).
+//    S = S(camera, v) - S(g, v) T (Eq. 44). The scattering network is fitted
+//    to the reference's radiance of the ray up to its end (ground or top, the
+//    DESIGN.md sample contract), so S(g, v) from the ground looking down is
+//    near 0 and Eq. 44 mostly removes the fit's residual there; it becomes the
+//    full aerial-perspective formula for segments ending in the air.
 //  Ground: albedo / pi max(0, n.s) T_sun(g) T (direct sun only).
 //
 // Output: radiance per unit solar irradiance (1/sr) and the segment's

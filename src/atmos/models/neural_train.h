@@ -38,7 +38,7 @@ struct NeuralFitOptions {
     // Beyond the thesis: the step size decays exponentially from
     // learning_rate to final_learning_rate over the steps (equal: constant).
     double final_learning_rate = 0.01;
-    double holdout = 0.1;         // fraction of samples held out
+    double holdout = 0.1;  // fraction of samples held out
     uint64_t seed = 1;
 };
 
