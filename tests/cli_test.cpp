@@ -188,6 +188,30 @@ TEST(Cli, BackendOption) {
     }
 }
 
+TEST(Cli, FitWritesWeightsTheModelLoads) {
+    // A tiny fit against the cheap `naive` model; the neural model then loads it.
+    const std::string w = (TempDir() / "neural_fit.json").string();
+    const Result r = RunAtmos(
+        "fit --model neural --reference naive --transmittance-samples 200 --scattering-samples 400 "
+        "--transmittance-steps 50 --scattering-steps 50 -o " +
+        w);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("held-out"), std::string::npos) << r.out;
+    const std::string png = (TempDir() / "neural_fit.png").string();
+    const Result render = RunAtmos("render --model neural --weights " + w +
+                                   " --view ground-noon --size 16x9 -q -o " + png);
+    EXPECT_EQ(render.status, 0) << render.err;
+    ExpectError("fit --model naive -o " + w, "only --model neural");
+    ExpectError("fit --model neural --reference nope -o " + w, "nope");
+    ExpectError(
+        "render --model neural --weights /no/such/w.json --view ground-noon --size 16x9 -o " + png,
+        "/no/such/w.json");
+    // Weights fitted to earth used with another atmosphere.
+    ExpectError(
+        "render --model neural --set top_radius=6420000 --view ground-noon --size 16x9 -o " + png,
+        "another atmosphere");
+}
+
 TEST(Cli, Help) {
     const Result r = RunAtmos("render --help");
     EXPECT_EQ(r.status, 0);

@@ -64,5 +64,6 @@ Command AddRmseCommand(CLI::App* root);
 Command AddCompareCommand(CLI::App* root, int argc, char** argv);
 Command AddBenchCommand(CLI::App* root);
 Command AddLocCommand(CLI::App* root);
+Command AddFitCommand(CLI::App* root);
 
 }  // namespace atmos::cli

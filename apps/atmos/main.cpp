@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
         AddCompareCommand(&app, argc, argv),
         AddBenchCommand(&app),
         AddLocCommand(&app),
+        AddFitCommand(&app),
     };
     try {
         if (argc > 1 && argv[1][0] != '-') {

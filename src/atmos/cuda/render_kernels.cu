@@ -19,6 +19,7 @@
 #include "models/flat.h"
 #include "models/hillaire.h"
 #include "models/naive.h"
+#include "models/neural.h"
 #include "models/oneil.h"
 #include "models/preetham.h"
 #include "models/raymarched.h"

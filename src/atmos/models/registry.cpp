@@ -12,6 +12,7 @@
 #include "models/flat.h"
 #include "models/hillaire.h"
 #include "models/naive.h"
+#include "models/neural.h"
 #include "models/reference.h"
 #include "models/oneil.h"
 #include "models/preetham.h"
@@ -58,6 +59,7 @@ const std::vector<Entry>& Registry() {
         MakeEntry<HillaireModel>(),
         MakeEntry<BrunetonModel>(),
         MakeEntry<AtmospherePlusModel>(),
+        MakeEntry<NeuralModel>(),
     };
     return entries;
 }

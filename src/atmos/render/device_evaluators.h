@@ -24,6 +24,7 @@ struct OneilEvaluator;
 struct PreethamEvaluator;
 struct BrunetonEvaluator;
 struct AtmospherePlusEvaluator;
+struct NeuralEvaluator;
 template <typename Optics>
 struct TransmittanceEvaluator;
 struct ReferenceTransmittanceOptics;
@@ -45,6 +46,7 @@ struct PolynomialTransmittanceOptics;
     X(PreethamEvaluator)                                    \
     X(BrunetonEvaluator)                                    \
     X(AtmospherePlusEvaluator)                              \
+    X(NeuralEvaluator)                                      \
     X(TransmittanceEvaluator<ReferenceTransmittanceOptics>) \
     X(TransmittanceEvaluator<FlatOptics>)                   \
     X(TransmittanceEvaluator<ErfcTransmittanceOptics>)      \

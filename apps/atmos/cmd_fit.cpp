@@ -1,0 +1,128 @@
+// atmos CLI: `atmos fit`: fits a fitted model (today: `neural`) to a reference
+// model and writes its weights as JSON.
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "atmos/atmosphere.h"
+#include "atmos/error.h"
+#include "atmos/model.h"
+#include "base/parallel.h"
+#include "cli_common.h"
+#include "models/neural_train.h"
+
+namespace atmos::cli {
+
+namespace {
+
+struct FitOptions {
+    std::string model = "neural";
+    std::string atmosphere = "earth";
+    std::vector<std::string> sets;
+    std::string reference = "bruneton";
+    int reference_spp = 64;
+    std::string output;
+    int threads = 0;
+    bool quiet = false;
+    NeuralFitOptions fit;
+};
+
+int CmdFit(const FitOptions& o) {
+    if (o.model != "neural") Fail("fit: only --model neural can be fitted, got '", o.model, "'");
+    if (o.reference == o.model) Fail("fit: --reference cannot be the model being fitted");
+    if (o.output.empty()) Fail("fit: -o FILE.json is required");
+    ThreadLimit limit(o.threads);
+    const AtmosphereParameters atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
+    std::map<std::string, std::string> ref_options;
+    if (o.reference == "reference") ref_options["spp"] = std::to_string(o.reference_spp);
+    // CreateModel rejects an unknown name with one clear error.
+    std::unique_ptr<Model> reference = CreateModel(o.reference, ref_options);
+    const auto t0 = std::chrono::steady_clock::now();
+    reference->Prepare(atmosphere);
+    const double prepare_s = Seconds(t0);
+    NeuralFitReport report;
+    NeuralWeights w = FitNeural(*reference, atmosphere, o.fit, &report);
+    // Record where the data came from.
+    {
+        std::string t = w.training_json;
+        const std::string extra =
+            "\"reference\":\"" + o.reference + "\",\"atmosphere\":\"" + o.atmosphere + "\",";
+        if (t.size() >= 2 && t.front() == '{') t.insert(1, extra);
+        w.training_json = t;
+    }
+    const std::string text = NeuralWeightsToJson(w);
+    std::ofstream out(o.output, std::ios::binary);
+    if (!out) Fail("fit: cannot write '", o.output, "'");
+    out << text;
+    out.close();
+    if (!out) Fail("fit: error writing '", o.output, "'");
+    if (!o.quiet) {
+        auto line = [](const char* name, const NeuralNetFitReport& r) {
+            std::printf(
+                "%-13s loss %.5g -> %.5g; RMS ln-error train %.4f, held-out %.4f; held-out mean "
+                "|error| / mean value %.4f\n",
+                name, r.loss.empty() ? 0.0 : r.loss.front(), r.loss.empty() ? 0.0 : r.loss.back(),
+                r.train_rms_log, r.holdout_rms_log, r.holdout_rel_mean);
+        };
+        std::printf("reference %s prepared in %.2f s; sampled in %.2f s; trained in %.2f s\n",
+                    o.reference.c_str(), prepare_s, report.sample_seconds, report.train_seconds);
+        line("transmittance", report.transmittance);
+        line("scattering", report.scattering);
+        std::printf("wrote %s\n", o.output.c_str());
+    }
+    return 0;
+}
+
+}  // namespace
+
+Command AddFitCommand(CLI::App* root) {
+    auto o = std::make_shared<FitOptions>();
+    Command c;
+    c.app = root->add_subcommand(
+        "fit", "fit the neural model's networks to a reference model; write the weights as JSON");
+    c.app->add_option("--model", o->model, "model to fit (neural)")->capture_default_str();
+    c.app->add_option("--atmosphere", o->atmosphere, "preset name or JSON file")
+        ->capture_default_str();
+    c.app->add_option("--set", o->sets, "override an atmosphere field: FIELD=VALUE");
+    c.app
+        ->add_option("--reference", o->reference,
+                     "model sampled for the training data: bruneton (fast) or reference (path "
+                     "tracer)")
+        ->capture_default_str();
+    c.app->add_option("--reference-spp", o->reference_spp, "samples per query for the path tracer")
+        ->capture_default_str();
+    c.app
+        ->add_option("--network", o->fit.network,
+                     "thesis (4-8-8-3 scattering) or large (7-32-32-3, extended inputs)")
+        ->capture_default_str();
+    c.app->add_option("--transmittance-samples", o->fit.transmittance_samples)
+        ->capture_default_str();
+    c.app->add_option("--scattering-samples", o->fit.scattering_samples)->capture_default_str();
+    c.app->add_option("--transmittance-steps", o->fit.transmittance_steps, "Adam steps")
+        ->capture_default_str();
+    c.app->add_option("--scattering-steps", o->fit.scattering_steps, "Adam steps")
+        ->capture_default_str();
+    c.app->add_option("--batch", o->fit.batch, "mini-batch size")->capture_default_str();
+    c.app->add_option("--learning-rate", o->fit.learning_rate, "Adam step size")
+        ->capture_default_str();
+    c.app
+        ->add_option("--final-learning-rate", o->fit.final_learning_rate,
+                     "step size at the last step (exponential decay; equal to --learning-rate: "
+                     "constant, as the thesis)")
+        ->capture_default_str();
+    c.app->add_option("--holdout", o->fit.holdout, "fraction of samples held out")
+        ->capture_default_str();
+    c.app->add_option("--seed", o->fit.seed, "seed of sampling, initialisation, batches")
+        ->capture_default_str();
+    c.app->add_option("-o,--output", o->output, "weights JSON to write")->required();
+    c.app->add_option("--threads", o->threads, "threads (0: all)")->capture_default_str();
+    c.app->add_flag("--quiet", o->quiet, "print nothing");
+    c.run = [o] { return CmdFit(*o); };
+    return c;
+}
+
+}  // namespace atmos::cli

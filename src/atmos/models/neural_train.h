@@ -1,0 +1,63 @@
+// atmos: fitting the `neural` model's networks (host side; `atmos fit`).
+//
+// Source: seed 003 section 9.6 (Adam, learning rate 0.01; network sizes) and
+// 9.1 (training data: transmittance over (h, mu), scattering over
+// (h, mu, mu_s, nu), height squared); Kingma & Ba 2015 (Adam, Algorithm 1).
+//
+// The training data come from a reference model's Sample() (DESIGN.md sample
+// contract): transmittance of rays that reach the top of the atmosphere
+// (mu above the horizon; the model reverses rays that look down, seed 003
+// section 9.6.3), and sky radiance per unit irradiance for rays to their end.
+// Loss: mean squared difference of ln(y + eps), eps = 1e-4 (a relative error,
+// so that twilight and the zenith count alike). Training is single-threaded
+// and uses the counter-based Rng only, so it is deterministic for a seed.
+//
+// The networks are small (at most ~1400 weights), so the multilayer
+// perceptron, its backpropagation and Adam are written out here (clear loops in
+// double) rather than pulling in a linear-algebra or learning library.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "atmos/atmosphere.h"
+#include "atmos/model.h"
+#include "models/neural.h"
+
+namespace atmos {
+
+struct NeuralFitOptions {
+    std::string network = "thesis";  // thesis: 4-8-8-3; large: 7-32-32-3, extended inputs
+    int transmittance_samples = 4096;
+    int scattering_samples = 16384;
+    int transmittance_steps = 3000;
+    int scattering_steps = 8000;
+    int batch = 128;
+    double learning_rate = 0.01;  // seed 003 section 9.6
+    // Beyond the thesis: the step size decays exponentially from
+    // learning_rate to final_learning_rate over the steps (equal: constant).
+    double final_learning_rate = 0.01;
+    double holdout = 0.1;  // fraction of samples held out
+    uint64_t seed = 1;
+};
+
+struct NeuralNetFitReport {
+    std::vector<double> loss;       // mean batch loss per 1% of the steps
+    double train_rms_log = 0.0;     // RMS of ln((y_hat + eps) / (y + eps)) over the train set
+    double holdout_rms_log = 0.0;   // same over the held-out set
+    double holdout_rel_mean = 0.0;  // mean |y_hat - y| / mean y over the held-out set
+};
+
+struct NeuralFitReport {
+    NeuralNetFitReport transmittance;
+    NeuralNetFitReport scattering;
+    double sample_seconds = 0.0;
+    double train_seconds = 0.0;
+};
+
+// Samples `reference` (already prepared for `atmosphere`) and fits both networks.
+NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atmosphere,
+                        const NeuralFitOptions& options, NeuralFitReport* report);
+
+}  // namespace atmos
