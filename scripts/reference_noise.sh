@@ -17,13 +17,13 @@ for view in $views; do
         for spp in $spps; do
             for seed in 1 2; do
                 start=$(date +%s.%N)
-                build/atmos render --model reference --estimator "$estimator" --spp "$spp" \
+                "${ATMOS:-build/atmos}" render --model reference --estimator "$estimator" --spp "$spp" \
                     --seed "$seed" --view "$view" --size "$size" -q --checkpoint "$tmp/ckpt$seed" \
                     -o "$tmp/$seed.exr"
                 end=$(date +%s.%N)
             done
-            flip=$(build/atmos flip "$tmp/1.exr" "$tmp/2.exr" | awk '{v=$NF} END {print v}')
-            rmse=$(build/atmos rmse "$tmp/1.exr" "$tmp/2.exr" | awk '{v=$NF} END {print v}')
+            flip=$("${ATMOS:-build/atmos}" flip "$tmp/1.exr" "$tmp/2.exr" | awk '{v=$NF} END {print v}')
+            rmse=$("${ATMOS:-build/atmos}" rmse "$tmp/1.exr" "$tmp/2.exr" | awk '{v=$NF} END {print v}')
             secs=$(echo "$end - $start" | bc -l)
             echo "$view,$estimator,$spp,$size,$secs,$flip,$rmse"
         done
