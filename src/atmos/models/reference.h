@@ -22,11 +22,17 @@
 //   profiles). Tracking steps to the shell boundary and resamples there
 //   (memoryless). A global majorant is the special case of one shell
 //   (`--shells 1`); bench/reference_bench.cpp measures both.
+// * A forced first collision on the view ray (when the segment ends in space
+//   or on a black ground), its distance drawn from an equal mixture of the
+//   majorant density and a uniform density over the segment (one-sample MIS):
+//   thin rays (the limb, twilight) no longer waste most paths.
 //
-// Light: next-event estimation toward the sun at every scattering vertex, the
-// sun's transmittance by ratio tracking (Novak et al. 2014; seed 003 Eq. 13)
-// against the same majorants, per channel (unbiased, and cheaper here than a
-// deterministic integral of comparable accuracy); a light ray that hits the
+// Light: next-event estimation toward the sun at every tentative collision
+// (with the expected value of the event choice, see TracePath) and at ground
+// vertices, the sun's transmittance by ratio tracking (Novak et al. 2014; seed
+// 003 Eq. 13) against the same majorants scaled for bounded variance, per
+// channel (unbiased, and cheaper here than a deterministic integral of
+// comparable accuracy, which would also carry quadrature bias); a light ray that hits the
 // ground is blocked (planet shadow). The sun is directional (the other models
 // treat it so too). A Lambertian ground of the atmosphere's albedo: NEE to the
 // sun and a cosine-sampled bounce; albedo 0 ends the path (a black ground that
