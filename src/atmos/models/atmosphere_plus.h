@@ -237,11 +237,8 @@ struct AtmospherePlusEvaluator {
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                 bool want_ground) const {
         RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg =
-            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
-        out.hits_ground = seg.hits_ground;
-        if (!seg.inside) return out;
+        AtmosphereSegment seg;
+        if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) return out;
         // Seed 000 2.4: P_0 is the camera, or where the ray enters the atmosphere.
         const Vec3d p0 = camera + dir * seg.t_start;
         const double r = Length(p0);
@@ -282,11 +279,8 @@ struct AtmospherePlusDirectEvaluator {
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                 bool) const {
         RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg =
-            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
-        out.hits_ground = seg.hits_ground;
-        if (!seg.inside) return out;
+        AtmosphereSegment seg;
+        if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) return out;
         const Vec3d p0 = camera + dir * seg.t_start;
         const double r = Length(p0);
         const double h = Clamp(r - atm.bottom_radius, 0.0, atm.top_radius - atm.bottom_radius);

@@ -101,10 +101,8 @@ struct FlatEvaluator {
                                 bool want_ground) const {
         const AnalyticMedia& m = optics.m;
         RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, m.bottom, m.top);
-        out.hits_ground = seg.hits_ground;
-        if (!seg.inside) return out;
+        AtmosphereSegment seg;
+        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) return out;
         const MediaLengths l = optics.SegmentLengths(camera, dir, seg.t_start, seg.t_end);
         const Vec3d tau = m.Extinction(l.rayleigh, l.mie, l.ozone);
         const Vec3d p0 = camera + dir * seg.t_start;

@@ -358,11 +358,8 @@ struct HillaireEvaluator {
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                 bool want_ground) const {
         RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg =
-            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
-        out.hits_ground = seg.hits_ground;
-        if (!seg.inside) return out;
+        AtmosphereSegment seg;
+        if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) return out;
         const double r = Length(camera);
         Vec3d L, T(1.0);
         if (sky_view.data != nullptr && r <= atm.top_radius) {

@@ -74,10 +74,8 @@ struct NeuralEvaluator {
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                 bool want_ground) const {
         RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, bottom, top);
-        out.hits_ground = seg.hits_ground;
-        if (!seg.inside) return out;
+        AtmosphereSegment seg;
+        if (!BeginRay(camera, dir, bottom, top, &out, &seg)) return out;
         // Viewer moved to the atmosphere's boundary (seed 003 section 9.6.3).
         Vec3d p = camera + dir * seg.t_start;
         double r = Length(p);

@@ -105,10 +105,8 @@ struct OneilEvaluator {
                                 bool want_ground) const {
         const AnalyticMedia& m = optics.m;
         RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, m.bottom, m.top);
-        out.hits_ground = seg.hits_ground;
-        if (!seg.inside) return out;
+        AtmosphereSegment seg;
+        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) return out;
         const double ds = (seg.t_end - seg.t_start) / steps;
         Vec3d sum_r, sum_m;
         for (int i = 0; i < steps; ++i) {

@@ -36,10 +36,8 @@ struct RaymarchedEvaluator {
                                 bool want_ground) const {
         const AnalyticMedia& m = optics.m;
         RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, m.bottom, m.top);
-        out.hits_ground = seg.hits_ground;
-        if (!seg.inside) return out;
+        AtmosphereSegment seg;
+        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) return out;
         const double dt = (seg.t_end - seg.t_start) / steps;
         Vec3d tau_view;  // camera to the start of the current part
         Vec3d light_a = optics.LightDepth(camera + dir * seg.t_start, sun);

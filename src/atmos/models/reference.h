@@ -428,11 +428,8 @@ struct ReferenceEvaluator {
     ATMOS_HD RayResult EvaluateKeyed(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                      bool want_ground, uint64_t key) const {
         RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg =
-            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
-        out.hits_ground = seg.hits_ground;
-        if (!seg.inside) return out;
+        AtmosphereSegment seg;
+        if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) return out;
         const Vec3d start = camera + dir * seg.t_start;
         out.transmittance = Rgb(Exp(-OpticalDepth(atm, start, dir, seg.t_end - seg.t_start, 1024)));
         const int shell = seg.t_start > 0.0 ? shells.count - 1 : shells.ShellOf(Length(start));

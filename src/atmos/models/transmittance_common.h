@@ -27,10 +27,8 @@ struct TransmittanceEvaluator {
 
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d&, bool) const {
         RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, bottom, top);
-        out.hits_ground = seg.hits_ground;
-        if (!seg.inside) return out;
+        AtmosphereSegment seg;
+        if (!BeginRay(camera, dir, bottom, top, &out, &seg)) return out;
         const Vec3d tau = optics.SegmentDepth(camera, dir, seg.t_start, seg.t_end);
         out.transmittance = Rgb(Exp(-Max(tau, Vec3d(0.0))));
         return out;

@@ -28,10 +28,8 @@ ATMOS_HD inline RayResult IntegrateSingleScattering(const AtmosphereParameters& 
                                                     const Vec3d& camera, const Vec3d& dir,
                                                     const Vec3d& sun, bool want_ground) {
     RayResult out;
-    out.transmittance = Rgb(1.0f);
-    const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
-    out.hits_ground = seg.hits_ground;
-    if (!seg.inside) return out;
+    AtmosphereSegment seg;
+    if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) return out;
     const double ds = (seg.t_end - seg.t_start) / steps;
     const double nu = Dot(dir, sun);
     Vec3d tau_view;  // camera to the start of the current step

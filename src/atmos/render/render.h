@@ -43,6 +43,19 @@ struct RayResult {
     bool hits_ground = false;
 };
 
+// The opening every evaluator shares: clips the ray camera + t dir to the
+// atmosphere shell [bottom, top] into *seg and resets *out (transmittance 1,
+// hits_ground from the clip). Returns false when the ray does not cross the
+// atmosphere: *out is then the whole answer (L = 0, T = 1).
+ATMOS_HD inline bool BeginRay(const Vec3d& camera, const Vec3d& dir, double bottom, double top,
+                              RayResult* out, AtmosphereSegment* seg) {
+    *out = RayResult();
+    out->transmittance = Rgb(1.0f);
+    *seg = ClipToAtmosphere(camera, dir, bottom, top);
+    out->hits_ground = seg->hits_ground;
+    return seg->inside;
+}
+
 // Everything ShadePixel needs, trivially copyable (device-friendly).
 struct PixelSetup {
     Camera camera;
