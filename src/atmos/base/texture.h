@@ -87,6 +87,32 @@ struct TableView {
     }
 };
 
+// A non-owning, trivially copyable, writable view of a table: what a
+// precomputation stage (render/stages.h) writes its output through, on the host
+// or (re-pointed to device memory) on the device.
+struct TableOut {
+    float* data = nullptr;
+    int width = 0, height = 1, depth = 1;
+    int channels = 4;
+
+    ATMOS_HD size_t Offset(int x, int y, int z = 0) const {
+        return ((static_cast<size_t>(z) * height + y) * width + x) * static_cast<size_t>(channels);
+    }
+    ATMOS_HD float* Texel(int x, int y, int z = 0) const { return data + Offset(x, y, z); }
+    ATMOS_HD void Set(int x, int y, int z, const Vec4f& v) const {
+        float* p = Texel(x, y, z);
+        p[0] = v.x;
+        if (channels > 1) p[1] = v.y;
+        if (channels > 2) p[2] = v.z;
+        if (channels > 3) p[3] = v.w;
+    }
+    ATMOS_HD size_t size() const {
+        return static_cast<size_t>(width) * height * depth * static_cast<size_t>(channels);
+    }
+    // The same table, read-only.
+    ATMOS_HD TableView view() const { return {data, width, height, depth, channels}; }
+};
+
 // A host-owned table.
 class Table {
   public:
@@ -120,6 +146,10 @@ class Table {
     }
 
     const TableView& view() const { return view_; }
+    // A writable view (valid until the next Resize or assignment).
+    TableOut out() {
+        return {data_.data(), view_.width, view_.height, view_.depth, view_.channels};
+    }
     int width() const { return view_.width; }
     int height() const { return view_.height; }
     int depth() const { return view_.depth; }
