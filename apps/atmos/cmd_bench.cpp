@@ -7,12 +7,25 @@
 // --backend cuda: the render kernel alone is timed on the device, between CUDA
 // events (DeviceTimingRequest, base/parallel.h): `warmup` untimed launches
 // (default 16), then `repeat` timed ones (default 256, as the thesis); table
-// uploads and the copy back are excluded. Prepare() still runs on the CPU.
+// uploads and the copy back are excluded. Prepare() runs on the chosen backend:
+// --prepare-repeat times (default 1; the first run on a device also pays for
+// loading its kernels, so ask for a few), the median reported.
+//
+// Precomputation stages (render/stages.h) are logged per Prepare() and per
+// render (Hillaire's per-frame tables): the median over the runs of each
+// stage's kernel time (CPU: wall time of its ParallelFor; CUDA: between events)
+// and of its whole call (CUDA: with the copies) go to the stages CSV
+// (`--stages-output`, default beside the CSV: <stem>_stages.csv).
+//
+// Monte Carlo models (the reference, only when named in --models) are timed as
+// whole renders (wall time, both backends, --repeat default 3 on cuda) and
+// their paths per second (width x height x spp / median) go in the CSV.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,6 +37,7 @@
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "harness/machine.h"
+#include "render/stages.h"
 
 namespace fs = std::filesystem;
 
@@ -41,9 +55,55 @@ struct BenchOptions {
     int warmup = 1;
     int threads = 0;
     std::string backend = "cpu";
+    std::vector<std::string> options;  // NAME=VALUE, to every model that has NAME
+    int prepare_repeat = 1;
+    std::string stages_output;
     CLI::Option* repeat_flag = nullptr;
     CLI::Option* warmup_flag = nullptr;
 };
+
+double Median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// --option NAME=VALUE for one model: those of its options it declares.
+std::map<std::string, std::string> OptionsFor(const std::string& model,
+                                              const std::vector<std::string>& given) {
+    std::map<std::string, std::string> out;
+    const ModelInfo& info = GetModelInfo(model);
+    for (const std::string& text : given) {
+        const size_t eq = text.find('=');
+        const std::string name = text.substr(0, eq);
+        for (const ModelOptionSpec& spec : info.options) {
+            if (spec.name == name) out[name] = text.substr(eq + 1);
+        }
+    }
+    return out;
+}
+
+// Per stage name, in first-seen order: its runs' kernel and total times.
+struct StageRuns {
+    std::string name, backend;
+    int64_t items = 0;
+    std::vector<double> kernel_ms, total_ms;
+};
+void AddStageRuns(const std::vector<StageTime>& log, std::vector<StageRuns>* runs) {
+    for (const StageTime& t : log) {
+        StageRuns* r = nullptr;
+        for (StageRuns& existing : *runs) {
+            if (existing.name == t.name && existing.items == t.items) r = &existing;
+        }
+        if (!r) {
+            runs->push_back({t.name, t.backend, t.items, {}, {}});
+            r = &runs->back();
+        }
+        r->kernel_ms.push_back(t.kernel_ms);
+        r->total_ms.push_back(t.total_ms);
+    }
+}
 
 std::string CsvField(const std::string& s) {
     if (s.find_first_of(",\"\n") == std::string::npos) return s;
@@ -66,6 +126,16 @@ int CmdBench(const BenchOptions& o) {
         }
     }
     for (const std::string& m : models) GetModelInfo(m);
+    for (const std::string& text : o.options) {
+        const size_t eq = text.find('=');
+        if (eq == std::string::npos || eq == 0) Fail("--option '", text, "': expected NAME=VALUE");
+        bool used = false;
+        for (const std::string& m : models) used = used || !OptionsFor(m, {text}).empty();
+        if (!used)
+            Fail("--option '", text, "': no model of --models has an option '", text.substr(0, eq),
+                 "'");
+    }
+    if (o.prepare_repeat < 1) Fail("--prepare-repeat must be at least 1");
     std::vector<View> views;
     for (const std::string& v : o.views.empty() ? StandardViewNames() : o.views) {
         views.push_back(GetView(v, atmosphere));
@@ -83,14 +153,57 @@ int CmdBench(const BenchOptions& o) {
     std::ofstream csv(o.output);
     if (!csv) Fail("cannot write '", o.output, "'");
     csv << "model,view,width,height,quantity,threads,prepare_s,render_median_s,render_min_s,"
-           "render_max_s,repeat,megapixels_per_s,cpu,compiler,backend\n";
+           "render_max_s,repeat,megapixels_per_s,paths_per_s,cpu,compiler,backend\n";
+    const std::string stages_path = !o.stages_output.empty()
+                                        ? o.stages_output
+                                        : (fs::path(o.output).parent_path() /
+                                           (fs::path(o.output).stem().string() + "_stages.csv"))
+                                              .string();
+    std::ofstream stages_csv(stages_path);
+    if (!stages_csv) Fail("cannot write '", stages_path, "'");
+    stages_csv << "model,view,stage,items,backend,runs,kernel_median_ms,total_median_ms\n";
+    auto write_stages = [&](const std::string& model, const std::string& view,
+                            const std::vector<StageRuns>& runs) {
+        for (const StageRuns& r : runs) {
+            const double k = Median(r.kernel_ms), t = Median(r.total_ms);
+            stages_csv << model << "," << view << "," << CsvField(r.name) << "," << r.items << ","
+                       << r.backend << "," << r.kernel_ms.size() << "," << k << "," << t << "\n";
+            std::printf(
+                "  stage %-34s %10lld items %10.3f ms kernel %10.3f ms total (%s, %zu runs)\n",
+                r.name.c_str(), static_cast<long long>(r.items), k, t, r.backend.c_str(),
+                r.kernel_ms.size());
+        }
+    };
     std::printf("%-20s %-22s %12s %12s %12s %12s %10s\n", "model", "view", "prepare_ms",
                 "median_ms", "min_ms", "max_ms", "Mpix/s");
     for (const std::string& name : models) {
-        std::unique_ptr<Model> model = CreateModel(name);
-        const auto p0 = std::chrono::steady_clock::now();
-        model->Prepare(atmosphere);
-        const double prepare = Seconds(p0);
+        std::unique_ptr<Model> model = CreateModel(name, OptionsFor(name, o.options));
+        const bool stochastic = model->Info().capabilities.stochastic;
+        std::vector<double> prepares;
+        std::vector<StageRuns> prepare_stages;
+        for (int k = 0; k < o.prepare_repeat; ++k) {
+            std::vector<StageTime> log;
+            const StageLogScope log_scope(&log);
+            const auto p0 = std::chrono::steady_clock::now();
+            model->Prepare(atmosphere);
+            prepares.push_back(Seconds(p0));
+            AddStageRuns(log, &prepare_stages);
+        }
+        const double prepare = Median(prepares);
+        if (o.prepare_repeat > 1 || !prepare_stages.empty()) {
+            std::printf("%-20s prepare: median %.3f ms of %d (min %.3f, max %.3f)\n", name.c_str(),
+                        prepare * 1e3, o.prepare_repeat,
+                        *std::min_element(prepares.begin(), prepares.end()) * 1e3,
+                        *std::max_element(prepares.begin(), prepares.end()) * 1e3);
+        }
+        write_stages(name, "prepare", prepare_stages);
+        int64_t spp = 0;
+        if (stochastic) {
+            const ModelOptions opts(name, model->Info().options, OptionsFor(name, o.options));
+            for (const ModelOptionSpec& spec : model->Info().options) {
+                if (spec.name == "spp") spp = opts.GetInt("spp");
+            }
+        }
         for (const View& view : views) {
             RenderRequest request;
             request.view = view;
@@ -100,7 +213,10 @@ int CmdBench(const BenchOptions& o) {
             request.show_progress = false;
             Image image;
             std::vector<double> times;
-            if (on_device) {
+            std::vector<StageRuns> frame_stages;
+            std::vector<StageTime> frame_log;
+            const StageLogScope log_scope(&frame_log);
+            if (on_device && !stochastic) {
                 DeviceTimingRequest timing;
                 timing.warmup = warmup;
                 timing.repeats = repeat;
@@ -114,33 +230,45 @@ int CmdBench(const BenchOptions& o) {
                 for (float ms : timing.milliseconds)
                     times.push_back(1e-3 * static_cast<double>(ms));
             } else {
-                for (int i = 0; i < warmup; ++i) model->Render(request, &image);
-                for (int i = 0; i < repeat; ++i) {
+                const int runs =
+                    on_device && stochastic && o.repeat_flag->count() == 0 ? 3 : repeat;
+                const int warm =
+                    on_device && stochastic && o.warmup_flag->count() == 0 ? 1 : warmup;
+                for (int i = 0; i < warm; ++i) model->Render(request, &image);
+                frame_log.clear();
+                for (int i = 0; i < runs; ++i) {
                     const auto t0 = std::chrono::steady_clock::now();
                     model->Render(request, &image);
                     times.push_back(Seconds(t0));
                 }
             }
+            AddStageRuns(frame_log, &frame_stages);
             std::sort(times.begin(), times.end());
-            const size_t n = times.size();
-            const double median =
-                n % 2 == 1 ? times[n / 2] : 0.5 * (times[n / 2 - 1] + times[n / 2]);
+            const double median = Median(times);
             const double mpix = static_cast<double>(width) * height / median / 1e6;
+            const double paths =
+                stochastic ? static_cast<double>(width) * height * static_cast<double>(spp) / median
+                           : 0.0;
             csv << name << "," << view.name << "," << width << "," << height << ","
                 << QuantityName(quantity) << "," << threads << "," << prepare << "," << median
-                << "," << times.front() << "," << times.back() << "," << repeat << "," << mpix
-                << "," << CsvField(cpu) << "," << CsvField(compiler) << "," << BackendName(backend)
-                << "\n";
-            std::printf("%-20s %-22s %12.3f %12.3f %12.3f %12.3f %10.3f\n", name.c_str(),
+                << "," << times.front() << "," << times.back() << "," << times.size() << "," << mpix
+                << "," << paths << "," << CsvField(cpu) << "," << CsvField(compiler) << ","
+                << BackendName(backend) << "\n";
+            std::printf("%-20s %-22s %12.3f %12.3f %12.3f %12.3f %10.3f", name.c_str(),
                         view.name.c_str(), prepare * 1e3, median * 1e3, times.front() * 1e3,
                         times.back() * 1e3, mpix);
+            if (stochastic) std::printf("  %.4g paths/s", paths);
+            std::printf("\n");
+            write_stages(name, view.name, frame_stages);
             std::fflush(stdout);
         }
     }
     if (!csv) Fail("cannot write '", o.output, "'");
-    std::printf("%s: %d threads, %s, %s; %dx%d, median of %d after %d warm-up%s; wrote %s\n",
+    if (!stages_csv) Fail("cannot write '", stages_path, "'");
+    std::printf("%s: %d threads, %s, %s; %dx%d, median of %d after %d warm-up%s; wrote %s, %s\n",
                 BackendName(backend), threads, cpu.c_str(), compiler.c_str(), width, height, repeat,
-                warmup, on_device ? " (kernel time, CUDA events)" : "", o.output.c_str());
+                warmup, on_device ? " (kernel time, CUDA events)" : "", o.output.c_str(),
+                stages_path.c_str());
     return 0;
 }
 
@@ -152,6 +280,15 @@ Command AddBenchCommand(CLI::App* root) {
         "bench", "time Prepare() and Render() apart, per model and view (CSV + table)");
     cmd->add_option("--models", o->models, "models (default: all but the reference)")
         ->delimiter(',');
+    cmd->add_option("--option", o->options,
+                    "NAME=VALUE: a model option, given to every model of --models that has it "
+                    "(repeatable; e.g. spp=256)")
+        ->allow_extra_args(false);
+    cmd->add_option("--prepare-repeat", o->prepare_repeat,
+                    "Prepare() runs per model; the median is reported (default 1)")
+        ->capture_default_str();
+    cmd->add_option("--stages-output", o->stages_output,
+                    "CSV of the precomputation stages (default: <output stem>_stages.csv)");
     cmd->add_option("--views", o->views, "views (default: all 12)")->delimiter(',');
     cmd->add_option("--size,-s", o->size, "image size WIDTHxHEIGHT")->capture_default_str();
     cmd->add_option("--quantity", o->quantity, "radiance or transmittance")->capture_default_str();
