@@ -1,6 +1,7 @@
 // atmos: significant lines of code (seed 003 section 11.7; rules in loc.h).
 #include "harness/loc.h"
 
+#include <cstdlib>
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -153,6 +154,9 @@ ModelLoc CountModelLoc(const std::string& source_dir, const std::string& name) {
 }
 
 std::string DefaultSourceDir() {
+    // A binary run from another checkout (scripts/gpu_bundle.sh) is told where
+    // the sources are by the environment.
+    if (const char* env = std::getenv("ATMOS_SOURCE_DIR"); env && *env) return env;
 #ifdef ATMOS_SOURCE_DIR
     return ATMOS_SOURCE_DIR;
 #else

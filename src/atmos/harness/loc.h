@@ -33,7 +33,8 @@ struct ModelLoc {
 ModelLoc CountModelLoc(const std::string& source_dir, const std::string& name);
 // The thesis's count for a model name (seed 003 section 12.4), or -1.
 int ThesisLoc(const std::string& model, std::string* thesis_name = nullptr);
-// The repository root compiled into the library (ATMOS_SOURCE_DIR).
+// The repository root: $ATMOS_SOURCE_DIR when set, else the one compiled into
+// the library (ATMOS_SOURCE_DIR).
 std::string DefaultSourceDir();
 
 }  // namespace atmos
