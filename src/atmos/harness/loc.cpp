@@ -1,8 +1,8 @@
 // atmos: significant lines of code (seed 003 section 11.7; rules in loc.h).
 #include "harness/loc.h"
 
-#include <cstdlib>
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
