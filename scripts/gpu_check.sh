@@ -12,6 +12,10 @@
 #              median of 256 kernel launches after 16; Prepare() 5 times
 #   cpu-bench  the same models on this machine's CPU cores (for the ratio)
 #   paths      the path tracer's paths per second per view (1920x1080, 64 spp)
+#   roofline   Nsight Compute counters of one render kernel per model (VIEW,
+#              default ground-noon, at SIZE) and scripts/roofline.py's table
+#              (FLOPs and DRAM bytes per pixel, rates at the bench's medians:
+#              run `bench` first in the same $OUT)
 #   noise      reference noise floor at 1920x1080 (two seeds, HDR-FLIP between
 #              them) for NOISE_VIEWS (default ground-noon) at NOISE_SPP
 #   all        info tests sanitize bench paths
@@ -72,6 +76,21 @@ for phase in "${phases[@]}"; do
         paths)
             run paths "$B/atmos" bench --backend cuda --models reference --size "$SIZE" \
                 --option spp=64 --repeat 1 --warmup 1 -o "$OUT/bench_paths.csv" ;;
+        roofline)
+            metrics=dram__bytes_read.sum,dram__bytes_write.sum,gpu__time_duration.sum
+            for op in fadd fmul ffma dadd dmul dfma; do
+                metrics+=",smsp__sass_thread_inst_executed_op_${op}_pred_on.sum"
+            done
+            models="${MODELS:-$("$B/atmos" list | awk '/^models:/{m=1;next} /^[a-z]+:/{m=0} m && /^  [a-z]/{print $1}' | grep -v '^reference$')}"
+            for m in ${models//,/ }; do
+                run "ncu-$m" ncu --csv --page raw --print-units base --metrics "$metrics" \
+                    --kernel-name regex:RenderKernel --launch-count 1 \
+                    "$B/atmos" render --backend cuda --model "$m" --view "${VIEW:-ground-noon}" \
+                    --size "$SIZE" --quiet -o "/tmp/ncu-$m.exr"
+                cp "$OUT/ncu-$m.log" "$OUT/ncu_$m.csv"
+            done
+            run roofline python3 scripts/roofline.py "$OUT" --view "${VIEW:-ground-noon}" \
+                --size "$SIZE" ;;
         noise)
             for view in ${NOISE_VIEWS:-ground-noon}; do
                 for spp in ${NOISE_SPP:-1024 4096}; do
