@@ -60,7 +60,11 @@ void RenderImageDevice(const Evaluator& evaluator, const PixelSetup& setup, Imag
     const size_t bytes = static_cast<size_t>(setup.width) * setup.height * 3 * sizeof(float);
     DeviceBuffer pixels(bytes);
     const ImageView view{static_cast<float*>(pixels.data()), setup.width, setup.height};
-    const dim3 block(16, 16);
+    // 16 x 8 threads (4 warps of 16 x 2 pixels): the heaviest kernels use up to
+    // 166 registers per thread (ptxas, sm_90: reference 166, oneil 156, hillaire
+    // and bruneton 128), so a 256-thread block fits only once per SM where
+    // 128-thread blocks fit three times (12 warps instead of 8).
+    const dim3 block(16, 8);
     const dim3 grid((setup.width + block.x - 1) / block.x, (setup.height + block.y - 1) / block.y);
     auto launch = [&]() {
         RenderKernel<<<grid, block>>>(device_evaluator, setup, view);
