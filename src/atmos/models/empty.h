@@ -20,18 +20,11 @@ struct EmptyEvaluator {
     }
 };
 
-class EmptyModel : public EvaluatorModel<EmptyModel> {
+class EmptyModel : public SimpleEvaluatorModel<EmptyModel, EmptyEvaluator> {
   public:
-    explicit EmptyModel(const ModelOptions&) : info_(StaticInfo()), atm_(EarthAtmosphere()) {}
+    explicit EmptyModel(const ModelOptions&) {}
     static ModelInfo StaticInfo();
-    const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override { atm_ = atmosphere; }
-    EmptyEvaluator MakeEvaluator() const { return {}; }
-    const AtmosphereParameters& atmosphere() const { return atm_; }
-
-  private:
-    ModelInfo info_;
-    AtmosphereParameters atm_;
 };
 
 }  // namespace atmos

@@ -122,19 +122,11 @@ struct FlatEvaluator {
     }
 };
 
-class FlatModel : public EvaluatorModel<FlatModel> {
+class FlatModel : public SimpleEvaluatorModel<FlatModel, FlatEvaluator> {
   public:
     explicit FlatModel(const ModelOptions& options);
     static ModelInfo StaticInfo();
-    const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override;
-    FlatEvaluator MakeEvaluator() const { return evaluator_; }
-    const AtmosphereParameters& atmosphere() const { return atm_; }
-
-  private:
-    ModelInfo info_;
-    AtmosphereParameters atm_;
-    FlatEvaluator evaluator_;
 };
 
 }  // namespace atmos

@@ -29,7 +29,7 @@ ModelInfo NaiveModel::StaticInfo() {
     return info;
 }
 
-NaiveModel::NaiveModel(const ModelOptions& options) : info_(StaticInfo()) {
+NaiveModel::NaiveModel(const ModelOptions& options) {
     evaluator_.atm = EarthAtmosphere();
     evaluator_.steps = options.GetInt("steps");
     evaluator_.light_steps = options.GetInt("light-steps");

@@ -74,18 +74,14 @@ struct NaiveEvaluator {
     }
 };
 
-class NaiveModel : public EvaluatorModel<NaiveModel> {
+class NaiveModel : public SimpleEvaluatorModel<NaiveModel, NaiveEvaluator> {
   public:
     explicit NaiveModel(const ModelOptions& options);
     static ModelInfo StaticInfo();
-    const ModelInfo& Info() const override { return info_; }
-    void Prepare(const AtmosphereParameters& atmosphere) override { evaluator_.atm = atmosphere; }
-    NaiveEvaluator MakeEvaluator() const { return evaluator_; }
-    const AtmosphereParameters& atmosphere() const { return evaluator_.atm; }
-
-  private:
-    ModelInfo info_;
-    NaiveEvaluator evaluator_;
+    void Prepare(const AtmosphereParameters& atmosphere) override {
+        atm_ = atmosphere;
+        evaluator_.atm = atmosphere;
+    }
 };
 
 }  // namespace atmos

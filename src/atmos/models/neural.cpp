@@ -302,14 +302,13 @@ ModelInfo NeuralModel::StaticInfo() {
     return info;
 }
 
-NeuralModel::NeuralModel(const ModelOptions& options) : info_(StaticInfo()) {
+NeuralModel::NeuralModel(const ModelOptions& options) {
     weights_path_ = options.GetText("weights");
     network_ = options.GetText("network");
-    atmosphere_ = EarthAtmosphere();
 }
 
 void NeuralModel::Prepare(const AtmosphereParameters& atmosphere) {
-    atmosphere_ = atmosphere;
+    atm_ = atmosphere;
     NeuralWeights w;
     std::string source;
     if (!weights_path_.empty()) {

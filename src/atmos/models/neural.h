@@ -147,21 +147,15 @@ void CheckNeuralWeightsMatch(const NeuralWeights& weights, const AtmosphereParam
 NeuralEvaluator MakeNeuralEvaluator(const NeuralWeights& weights,
                                     const AtmosphereParameters& atmosphere);
 
-class NeuralModel : public EvaluatorModel<NeuralModel> {
+class NeuralModel : public SimpleEvaluatorModel<NeuralModel, NeuralEvaluator> {
   public:
     explicit NeuralModel(const ModelOptions& options);
     static ModelInfo StaticInfo();
-    const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override;
-    NeuralEvaluator MakeEvaluator() const { return evaluator_; }
-    const AtmosphereParameters& atmosphere() const { return atmosphere_; }
 
   private:
-    ModelInfo info_;
     std::string weights_path_;
     std::string network_;
-    AtmosphereParameters atmosphere_;
-    NeuralEvaluator evaluator_;
 };
 
 }  // namespace atmos

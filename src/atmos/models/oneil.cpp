@@ -52,7 +52,7 @@ ModelInfo OneilModel::StaticInfo() {
     return info;
 }
 
-OneilModel::OneilModel(const ModelOptions& options) : info_(StaticInfo()) {
+OneilModel::OneilModel(const ModelOptions& options) {
     evaluator_.steps = options.GetInt("steps");
     refit_ = options.GetText("fit") == "refit";
     Prepare(EarthAtmosphere());

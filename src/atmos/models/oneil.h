@@ -143,20 +143,14 @@ struct OneilEvaluator {
 // (physics/analytic_fit.h); otherwise his constants with scale depth 0.25.
 OneilOptics MakeOneilOptics(const AtmosphereParameters& atmosphere, bool refit);
 
-class OneilModel : public EvaluatorModel<OneilModel> {
+class OneilModel : public SimpleEvaluatorModel<OneilModel, OneilEvaluator> {
   public:
     explicit OneilModel(const ModelOptions& options);
     static ModelInfo StaticInfo();
-    const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override;
-    OneilEvaluator MakeEvaluator() const { return evaluator_; }
-    const AtmosphereParameters& atmosphere() const { return atm_; }
 
   private:
-    ModelInfo info_;
-    AtmosphereParameters atm_;
     bool refit_ = true;
-    OneilEvaluator evaluator_;
 };
 
 }  // namespace atmos

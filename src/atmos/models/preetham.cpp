@@ -44,7 +44,7 @@ ModelInfo PreethamModel::StaticInfo() {
     return info;
 }
 
-PreethamModel::PreethamModel(const ModelOptions& options) : info_(StaticInfo()) {
+PreethamModel::PreethamModel(const ModelOptions& options) {
     const double T = options.GetReal("turbidity");
     evaluator_.turbidity = T;
     evaluator_.kY = PreethamLuminanceCoefficients(T);

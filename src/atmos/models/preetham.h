@@ -146,19 +146,11 @@ struct PreethamEvaluator {
     }
 };
 
-class PreethamModel : public EvaluatorModel<PreethamModel> {
+class PreethamModel : public SimpleEvaluatorModel<PreethamModel, PreethamEvaluator> {
   public:
     explicit PreethamModel(const ModelOptions& options);
     static ModelInfo StaticInfo();
-    const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override;
-    PreethamEvaluator MakeEvaluator() const { return evaluator_; }
-    const AtmosphereParameters& atmosphere() const { return atm_; }
-
-  private:
-    ModelInfo info_;
-    AtmosphereParameters atm_;
-    PreethamEvaluator evaluator_;
 };
 
 }  // namespace atmos

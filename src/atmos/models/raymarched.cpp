@@ -16,7 +16,7 @@ ModelInfo RaymarchedModel::StaticInfo() {
     return info;
 }
 
-RaymarchedModel::RaymarchedModel(const ModelOptions& options) : info_(StaticInfo()) {
+RaymarchedModel::RaymarchedModel(const ModelOptions& options) {
     evaluator_.steps = options.GetInt("steps");
     Prepare(EarthAtmosphere());
 }

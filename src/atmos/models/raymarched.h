@@ -67,19 +67,11 @@ struct RaymarchedEvaluator {
     }
 };
 
-class RaymarchedModel : public EvaluatorModel<RaymarchedModel> {
+class RaymarchedModel : public SimpleEvaluatorModel<RaymarchedModel, RaymarchedEvaluator> {
   public:
     explicit RaymarchedModel(const ModelOptions& options);
     static ModelInfo StaticInfo();
-    const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override;
-    RaymarchedEvaluator MakeEvaluator() const { return evaluator_; }
-    const AtmosphereParameters& atmosphere() const { return atm_; }
-
-  private:
-    ModelInfo info_;
-    AtmosphereParameters atm_;
-    RaymarchedEvaluator evaluator_;
 };
 
 }  // namespace atmos

@@ -25,13 +25,14 @@ ModelInfo SchulerModel::StaticInfo() {
     return info;
 }
 
-SchulerModel::SchulerModel(const ModelOptions& options) : info_(StaticInfo()) {
+SchulerModel::SchulerModel(const ModelOptions& options) {
     evaluator_.steps = options.GetInt("steps");
     evaluator_.chapman_unit = ChapmanUnitFromOptions(options);
     Prepare(EarthAtmosphere());
 }
 
 void SchulerModel::Prepare(const AtmosphereParameters& atmosphere) {
+    atm_ = atmosphere;
     evaluator_.atm = atmosphere;
     evaluator_.m = MakeAnalyticMedia(atmosphere);
 }

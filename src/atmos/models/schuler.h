@@ -66,18 +66,11 @@ struct SchulerEvaluator {
     }
 };
 
-class SchulerModel : public EvaluatorModel<SchulerModel> {
+class SchulerModel : public SimpleEvaluatorModel<SchulerModel, SchulerEvaluator> {
   public:
     explicit SchulerModel(const ModelOptions& options);
     static ModelInfo StaticInfo();
-    const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override;
-    SchulerEvaluator MakeEvaluator() const { return evaluator_; }
-    const AtmosphereParameters& atmosphere() const { return evaluator_.atm; }
-
-  private:
-    ModelInfo info_;
-    SchulerEvaluator evaluator_;
 };
 
 }  // namespace atmos

@@ -46,23 +46,14 @@ inline ModelCapabilities TransmittanceCapabilities() {
 // Host side: Derived implements `static ModelInfo StaticInfo()` and
 // `Optics MakeOptics(const AtmosphereParameters&) const`.
 template <typename Derived, typename Optics>
-class TransmittanceModel : public EvaluatorModel<Derived> {
+class TransmittanceModel : public SimpleEvaluatorModel<Derived, TransmittanceEvaluator<Optics>> {
   public:
-    const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override {
-        atm_ = atmosphere;
-        evaluator_.bottom = atmosphere.bottom_radius;
-        evaluator_.top = atmosphere.top_radius;
-        evaluator_.optics = static_cast<const Derived&>(*this).MakeOptics(atmosphere);
+        this->atm_ = atmosphere;
+        this->evaluator_.bottom = atmosphere.bottom_radius;
+        this->evaluator_.top = atmosphere.top_radius;
+        this->evaluator_.optics = static_cast<const Derived&>(*this).MakeOptics(atmosphere);
     }
-    TransmittanceEvaluator<Optics> MakeEvaluator() const { return evaluator_; }
-    const AtmosphereParameters& atmosphere() const { return atm_; }
-
-  protected:
-    TransmittanceModel() : info_(Derived::StaticInfo()) {}
-    ModelInfo info_;
-    AtmosphereParameters atm_;
-    TransmittanceEvaluator<Optics> evaluator_;
 };
 
 }  // namespace atmos

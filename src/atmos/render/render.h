@@ -219,4 +219,22 @@ class EvaluatorModel : public Model {
     }
 };
 
+// The state most evaluator models are: their ModelInfo, the atmosphere of the
+// last Prepare() and one evaluator, handed out by value. Derived provides
+// `static ModelInfo StaticInfo()`, its constructor (from its options) and
+// Prepare(), which sets atm_ and fills evaluator_.
+template <typename Derived, typename Evaluator>
+class SimpleEvaluatorModel : public EvaluatorModel<Derived> {
+  public:
+    const ModelInfo& Info() const override { return info_; }
+    Evaluator MakeEvaluator() const { return evaluator_; }
+    const AtmosphereParameters& atmosphere() const { return atm_; }
+
+  protected:
+    SimpleEvaluatorModel() : info_(Derived::StaticInfo()), atm_(EarthAtmosphere()) {}
+    ModelInfo info_;
+    AtmosphereParameters atm_;
+    Evaluator evaluator_;
+};
+
 }  // namespace atmos
