@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -129,6 +130,27 @@ TEST(RenderCache, RoundTripAndKeying) {
     other.quantity = Quantity::kTransmittance;
     EXPECT_FALSE(cache.Load(other, &loaded, &seconds));
     EXPECT_FALSE(RenderCache("").Load(key, &loaded, &seconds));
+    // An image another build stored (same key otherwise) is not reused: edit the
+    // stored key text's build line as an older executable would have written it.
+    const std::string id = BuildIdentity();
+    EXPECT_EQ(id.size(), 16u);
+    EXPECT_EQ(id, BuildIdentity());
+    EXPECT_NE(RenderKeyText(key).find("build " + id + "\n"), std::string::npos);
+    const fs::path meta = fs::path(cache.ImagePath(key)).replace_extension(".json");
+    ASSERT_TRUE(fs::exists(meta)) << meta;
+    std::string text;
+    {
+        std::ifstream in(meta);
+        text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    const size_t at = text.find(id);
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, id.size(), std::string(16, '0'));
+    {
+        std::ofstream out(meta);
+        out << text;
+    }
+    EXPECT_FALSE(cache.Load(key, &loaded, &seconds));
 }
 
 TEST(Compare, ValidityFlags) {

@@ -13,9 +13,30 @@ namespace fs = std::filesystem;
 
 namespace atmos {
 
+std::string BuildIdentity() {
+    static const std::string identity = [] {
+        std::ifstream exe("/proc/self/exe", std::ios::binary);
+        if (!exe) return std::string("unknown");
+        std::uint64_t h = 14695981039346656037ull;
+        char buffer[1 << 16];
+        while (exe.read(buffer, sizeof(buffer)) || exe.gcount() > 0) {
+            const std::streamsize n = exe.gcount();
+            for (std::streamsize i = 0; i < n; ++i) {
+                h ^= static_cast<unsigned char>(buffer[i]);
+                h *= 1099511628211ull;
+            }
+        }
+        char text[17];
+        std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(h));
+        return std::string(text);
+    }();
+    return identity;
+}
+
 std::string RenderKeyText(const RenderKey& key) {
     std::ostringstream os;
-    os << "atmos-render-cache 1\n";
+    os << "atmos-render-cache 2\n";
+    os << "build " << BuildIdentity() << "\n";
     os << "model " << key.model << "\n";
     for (const auto& [name, value] : key.options) os << "option " << name << "=" << value << "\n";
     os << "view " << key.view << "\n";

@@ -5,8 +5,9 @@
 // view's name, the size and the quantity. The key text is hashed (FNV-1a, 64
 // bit) into the file name; the key text itself is stored beside the image and
 // compared on load, so a hash collision can never return a wrong image. The
-// key does not cover the model's source code: after changing a model, delete
-// the cache directory (or run compare with --no-cache).
+// key also holds the running executable's hash (BuildIdentity), so a rebuilt
+// atmos (changed model code, new embedded neural weights or presets) never
+// reuses an image an older build rendered; `--no-cache` skips the cache.
 #pragma once
 
 #include <cstdint>
@@ -28,7 +29,10 @@ struct RenderKey {
     Quantity quantity = Quantity::kRadiance;
 };
 
-// The canonical key text (one line per field).
+// A 64-bit FNV-1a hash of the running executable (/proc/self/exe), in hex;
+// "unknown" where it cannot be read. Computed once per process.
+std::string BuildIdentity();
+// The canonical key text (one line per field, the build identity included).
 std::string RenderKeyText(const RenderKey& key);
 std::uint64_t Fnv1a64(const std::string& text);
 // The resolved options of a model (every option at its given value or default).
