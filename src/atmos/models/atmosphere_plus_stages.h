@@ -133,9 +133,10 @@ struct AplusSingleScatteringStage {
 ATMOS_DEVICE_STAGE(AplusSingleScatteringStage)
 
 // Gather directions whose incoming values a texel keeps in a local array
-// (16 bytes each, about 1 KiB of stack); more (--gather-theta > 64) are looked
-// up again at every node, with the same result.
-constexpr int kAplusGatherCachedThetas = 64;
+// (16 bytes each: 784 bytes, so a device thread's stack frame stays under the
+// default 1 KiB stack limit); more (--gather-theta > 48) are looked up again at
+// every node, with the same result.
+constexpr int kAplusGatherCachedThetas = 48;
 
 // Seed 000 2.2, 2.3: the factored gather G(P, V, L) = int_4pi F(dot(w, V))
 // I_prev(P, w, L) dw on the table's grid, by the 2D trapezoidal rule (1.9) over
