@@ -14,6 +14,8 @@
 #include "atmos/error.h"
 #include "base/parallel.h"
 #include "io/table_io.h"
+#include "models/atmosphere_plus_stages.h"
+#include "render/stages.h"
 
 namespace atmos {
 
@@ -21,121 +23,6 @@ namespace {
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-double UnitCoord(int i, int size) { return size > 1 ? static_cast<double>(i) / (size - 1) : 0.0; }
-
-Vec4f ToVec4f(const AplusValue& v) {
-    return {static_cast<float>(v.rayleigh.x), static_cast<float>(v.rayleigh.y),
-            static_cast<float>(v.rayleigh.z), static_cast<float>(v.mie)};
-}
-
-AplusValue FromVec4f(const Vec4f& v) {
-    AplusValue a;
-    a.rayleigh =
-        Vec3d(static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z));
-    a.mie = static_cast<double>(v.w);
-    return a;
-}
-
-// Seed 000 sections 1.10: the transmittance table T(h, mu) of the view segment
-// (to the top of the atmosphere or to the ground), trapezoidal rule.
-Table ComputeTransmittance(const AtmosphereParameters& atm, const AplusSettings& s) {
-    const AplusMapping& m = s.mapping;
-    Table t(s.transmittance_width, s.transmittance_height, 1, 3);
-    ParallelFor(static_cast<int64_t>(s.transmittance_width) * s.transmittance_height, 64,
-                [&](int64_t i) {
-                    const int x = static_cast<int>(i % s.transmittance_width);
-                    const int y = static_cast<int>(i / s.transmittance_width);
-                    const double h = m.H(UnitCoord(x, s.transmittance_width));
-                    const double mu = m.Mu(h, UnitCoord(y, s.transmittance_height));
-                    const Vec3d p0(0.0, 0.0, atm.bottom_radius + h);
-                    const Vec3d dir(SafeSqrt(1.0 - mu * mu), 0.0, mu);
-                    const AtmosphereSegment seg =
-                        ClipToAtmosphere(p0, dir, atm.bottom_radius, atm.top_radius);
-                    Vec3d tr(1.0);
-                    if (seg.inside) {
-                        tr = Exp(-OpticalDepth(atm, p0 + dir * seg.t_start, dir,
-                                               seg.t_end - seg.t_start, s.transmittance_steps));
-                    }
-                    const Rgb c(tr);
-                    t.Set(x, y, 0, {c.x, c.y, c.z, 0.0f});
-                });
-    return t;
-}
-
-// Seed 000 2.2, 2.3: the factored gather G(P, V, L) = int_4pi F(dot(w, V))
-// I_prev(P, w, L) dw on the table's grid, by the 2D trapezoidal rule over
-// Theta in [0, pi] (x) and Phi in [0, 2 pi] (y), dw = sin(Theta) dTheta dPhi.
-// I_prev depends on w only through its zenith cosine (no azimuth), looked up
-// once per Theta node.
-Table ComputeGather(const Table& prev, const AtmosphereParameters& atm, const AplusSettings& s) {
-    const AplusMapping& m = s.mapping;
-    Table g(s.width, s.height, s.depth, 4);
-    const int n = s.gather_theta, mm = s.gather_phi;
-    const double d_theta = kPi / n;
-    const int64_t count = static_cast<int64_t>(s.width) * s.height * s.depth;
-    ParallelFor(count, 64, [&](int64_t i) {
-        const int x = static_cast<int>(i % s.width);
-        const int y = static_cast<int>((i / s.width) % s.height);
-        const int z = static_cast<int>(i / (static_cast<int64_t>(s.width) * s.height));
-        double h, mu, mu_s;
-        AplusTexelParameters(m, x, y, z, s.width, s.height, s.depth, &h, &mu, &mu_s);
-        std::vector<AplusValue> incoming(static_cast<size_t>(n) + 1);
-        for (int j = 0; j <= n; ++j) {
-            incoming[static_cast<size_t>(j)] =
-                FromVec4f(AplusSample(prev.view(), m, h, std::cos(j * d_theta), mu_s));
-        }
-        const double sin_phi = SafeSqrt(1.0 - mu * mu);
-        const auto f = [&](double theta, double phi) {
-            const int j = static_cast<int>(std::lround(theta / d_theta));
-            const double sin_t = std::sin(theta);
-            // cos of the scattering angle dot(-w, -V) = dot(w, V), V = (sin phi, 0, mu).
-            const double c = ClampCosine(sin_t * std::cos(phi) * sin_phi + std::cos(theta) * mu);
-            const AplusValue& in = incoming[static_cast<size_t>(j)];
-            AplusValue out;
-            out.rayleigh = in.rayleigh * (AplusRayleighPhase(c) * sin_t);
-            out.mie = in.mie * AplusMiePhase(atm.mie_phase_g, c) * sin_t;
-            return out;
-        };
-        g.Set(x, y, z, ToVec4f(AplusTrapezoid2D<AplusValue>(f, 0.0, kPi, 0.0, 2.0 * kPi, n, mm)));
-    });
-    return g;
-}
-
-// Seed 000 2.2, 2.3: the factored order k from the gather table of order k-1:
-// beta/(4 pi) int G(P, V, L) p(h) T(P, P_a) ds, trapezoidal rule.
-AplusValue OrderFromGather(const TableView& gather, const AtmosphereParameters& atm,
-                           const AplusSettings& s, double h, double mu, double mu_s) {
-    AplusValue out;
-    const Vec3d p0(0.0, 0.0, atm.bottom_radius + h);
-    const Vec3d view(SafeSqrt(1.0 - mu * mu), 0.0, mu);
-    const Vec3d sun(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
-    const AtmosphereSegment seg = ClipToAtmosphere(p0, view, atm.bottom_radius, atm.top_radius);
-    if (!seg.inside) return out;
-    const int steps = s.transmittance_steps;
-    const double ds = (seg.t_end - seg.t_start) / steps;
-    const double top = atm.top_radius - atm.bottom_radius;
-    Vec3d tau_view, prev_ext, sum_r;
-    double sum_m = 0.0;
-    for (int i = 0; i <= steps; ++i) {
-        const Vec3d p = p0 + view * (seg.t_start + i * ds);
-        const double r = Length(p);
-        const double hp = Clamp(r - atm.bottom_radius, 0.0, top);
-        const Densities d = GetDensities(atm, r - atm.bottom_radius);
-        const Vec3d ext = Extinction(atm, d);
-        if (i > 0) tau_view += (prev_ext + ext) * (0.5 * ds);
-        prev_ext = ext;
-        const AplusValue gp = FromVec4f(AplusSample(
-            gather, s.mapping, hp, ClampCosine(Dot(p, view) / r), ClampCosine(Dot(p, sun) / r)));
-        const Vec3d t = Exp(-tau_view);
-        const double w = (i == 0 || i == steps) ? 0.5 * ds : ds;
-        sum_r += gp.rayleigh * t * (d.rayleigh * w);
-        sum_m += gp.mie * Channel(t, kAplusMieChannel) * d.mie * w;
-    }
-    out.rayleigh = atm.rayleigh_scattering * sum_r / (4.0 * kPi);
-    out.mie = Channel(atm.mie_scattering, kAplusMieChannel) * sum_m / (4.0 * kPi);
-    return out;
 }
 
 void CheckSettings(const AplusSettings& s) {
@@ -152,13 +39,6 @@ void CheckSettings(const AplusSettings& s) {
 
 }  // namespace
 
-void AplusTexelParameters(const AplusMapping& m, int x, int y, int z, int width, int height,
-                          int depth, double* h, double* mu, double* mu_s) {
-    *h = m.H(UnitCoord(x, width));
-    *mu = m.Mu(*h, UnitCoord(y, height));
-    *mu_s = m.MuS(UnitCoord(z, depth));
-}
-
 AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings& settings_in,
                             bool keep_orders) {
     AplusSettings s = settings_in;
@@ -167,46 +47,33 @@ AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings
     CheckSettings(s);
     AplusTables out;
     auto start = std::chrono::steady_clock::now();
-    out.transmittance = ComputeTransmittance(atm, s);
+    out.transmittance = Table(s.transmittance_width, s.transmittance_height, 1, 3);
+    RunStage("atmosphere-plus/transmittance",
+             static_cast<int64_t>(s.transmittance_width) * s.transmittance_height, 64,
+             AplusTransmittanceStage{atm, s, out.transmittance.out()});
     out.transmittance_seconds = SecondsSince(start);
 
     const int64_t count = static_cast<int64_t>(s.width) * s.height * s.depth;
-    const auto cell = [&](int64_t i, int* x, int* y, int* z, double* h, double* mu, double* mu_s) {
-        *x = static_cast<int>(i % s.width);
-        *y = static_cast<int>((i / s.width) % s.height);
-        *z = static_cast<int>(i / (static_cast<int64_t>(s.width) * s.height));
-        AplusTexelParameters(s.mapping, *x, *y, *z, s.width, s.height, s.depth, h, mu, mu_s);
-    };
 
     // Order 1 (seed 000 2.1).
     start = std::chrono::steady_clock::now();
     Table order(s.width, s.height, s.depth, 4);
-    ParallelFor(count, 16, [&](int64_t i) {
-        int x, y, z;
-        double h, mu, mu_s;
-        cell(i, &x, &y, &z, &h, &mu, &mu_s);
-        order.Set(x, y, z,
-                  ToVec4f(AplusSingleScattering(atm, h, mu, mu_s, s.transmittance_steps,
-                                                s.transmittance_steps)));
-    });
+    RunStage("atmosphere-plus/order-1", count, 16, AplusSingleScatteringStage{atm, s, order.out()});
     out.scattering = order;
     out.order_seconds.push_back(SecondsSince(start));
     if (keep_orders) out.orders.push_back(order);
 
-    // Orders 2..K (seed 000 2.2).
+    // Orders 2..K (seed 000 2.2): gather from order k-1, order k, add to the sum.
     for (int k = 2; k <= s.orders; ++k) {
         start = std::chrono::steady_clock::now();
-        const Table gather = ComputeGather(order, atm, s);
+        Table gather(s.width, s.height, s.depth, 4);
+        RunStage("atmosphere-plus/gather", count, 16,
+                 AplusGatherStage{atm, s, order.view(), gather.out()});
         Table next(s.width, s.height, s.depth, 4);
-        ParallelFor(count, 16, [&](int64_t i) {
-            int x, y, z;
-            double h, mu, mu_s;
-            cell(i, &x, &y, &z, &h, &mu, &mu_s);
-            next.Set(x, y, z, ToVec4f(OrderFromGather(gather.view(), atm, s, h, mu, mu_s)));
-        });
-        float* total = out.scattering.data();
-        const float* add = next.data();
-        for (size_t j = 0; j < out.scattering.size(); ++j) total[j] += add[j];
+        RunStage("atmosphere-plus/order-k", count, 16,
+                 AplusOrderStage{atm, s, gather.view(), next.out()});
+        RunStage("atmosphere-plus/sum", count, 4096,
+                 AplusAddStage{next.view(), out.scattering.out()});
         order = std::move(next);
         out.order_seconds.push_back(SecondsSince(start));
         if (keep_orders) out.orders.push_back(order);

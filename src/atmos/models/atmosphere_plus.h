@@ -49,6 +49,8 @@
 // rays below the horizon at the ground row zero length (AplusSampleTable).
 // Defaults: horizon-centric mapping, 32 x 64 x 32 (the lowest measured table
 // error per MiB, docs/models.md), K = 5, 6 x 12 gather, n = 30.
+// Precomputation: the stage structs of atmosphere_plus_stages.h through
+// RunStage, on the CPU or (CUDA backend) on the device from the same code.
 #pragma once
 
 #include <string>
@@ -173,13 +175,26 @@ struct AplusTables {
     double transmittance_seconds = 0.0;
 };
 
-// Precomputes the tables (CPU, ParallelFor). keep_orders keeps each order's table.
+// Precomputes the tables through RunStage (atmosphere_plus_stages.h): on the
+// CPU, or on the device on the CUDA backend. keep_orders keeps each order's
+// table.
 AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings& settings,
                             bool keep_orders = false);
 
+// Texel i of a table of `size` texels holds the value at i / (size - 1) (seed
+// 000 2.4's x/(size-1); atmosphere_plus_mapping.h).
+ATMOS_HD inline double AplusUnitCoord(int i, int size) {
+    return size > 1 ? static_cast<double>(i) / (size - 1) : 0.0;
+}
+
 // The table's (h, mu, mu_s) of texel (x, y, z).
-void AplusTexelParameters(const AplusMapping& mapping, int x, int y, int z, int width, int height,
-                          int depth, double* h, double* mu, double* mu_s);
+ATMOS_HD inline void AplusTexelParameters(const AplusMapping& m, int x, int y, int z, int width,
+                                          int height, int depth, double* h, double* mu,
+                                          double* mu_s) {
+    *h = m.H(AplusUnitCoord(x, width));
+    *mu = m.Mu(*h, AplusUnitCoord(y, height));
+    *mu_s = m.MuS(AplusUnitCoord(z, depth));
+}
 
 // Samples a table laid out as the scattering table at (h, mu, mu_s): linear
 // between the two altitude rows around h, and in each row bilinear in (v, w)

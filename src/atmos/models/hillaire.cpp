@@ -15,6 +15,8 @@
 #include "atmos/error.h"
 #include "base/parallel.h"
 #include "io/table_io.h"
+#include "models/hillaire_stages.h"
+#include "render/stages.h"
 
 namespace atmos {
 
@@ -22,10 +24,6 @@ namespace {
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-Vec4f ToTexel(const Vec3d& v) {
-    return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0.0f};
 }
 
 }  // namespace
@@ -136,122 +134,55 @@ void HillaireModel::Prepare(const AtmosphereParameters& atmosphere) {
     prepare_timings_.multiple_scattering_s = SecondsSince(start);
 }
 
+// The evaluator the precomputation stages read: the model's tables, no frame
+// tables.
+HillaireEvaluator HillaireModel::StageEvaluator() const {
+    HillaireEvaluator e = evaluator_;
+    e.sky_view = e.ap_scatter = e.ap_transmittance = TableView{};
+    return e;
+}
+
 // Transmittance table: seed 004 ComputeTransmittanceToTopAtmosphereBoundaryTexture,
-// optical depth by the midpoint rule with transmittance_steps_ segments.
+// optical depth by the midpoint rule with transmittance_steps_ segments
+// (HillaireTransmittanceStage).
 void HillaireModel::BuildTransmittance() {
-    const AtmosphereParameters& atm = evaluator_.atm;
-    const int n = transmittance_steps_;
     transmittance_.Resize(kHillaireTransmittanceWidth, kHillaireTransmittanceHeight, 1, 3);
-    ParallelFor(kHillaireTransmittanceHeight, 1, [&](int64_t j64) {
-        const int j = static_cast<int>(j64);
-        for (int i = 0; i < kHillaireTransmittanceWidth; ++i) {
-            double r, mu;
-            HillaireTransmittanceRMu(
-                atm, static_cast<double>(i) / (kHillaireTransmittanceWidth - 1),
-                static_cast<double>(j) / (kHillaireTransmittanceHeight - 1), &r, &mu);
-            const double d = DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius);
-            const Vec3d dir(SafeSqrt(1.0 - mu * mu), 0.0, mu);
-            const double dt = d / n;
-            Vec3d tau;
-            for (int k = 0; k < n; ++k) {
-                const Vec3d p(dir.x * (k + 0.5) * dt, 0.0, r + dir.z * (k + 0.5) * dt);
-                tau += Extinction(atm, GetDensities(atm, Length(p) - atm.bottom_radius));
-            }
-            transmittance_.Set(i, j, 0, ToTexel(Exp(-(tau * dt))));
-        }
-    });
+    HillaireTransmittanceStage stage;
+    stage.atm = evaluator_.atm;
+    stage.steps = transmittance_steps_;
+    stage.out = transmittance_.out();
+    RunStage("hillaire/transmittance",
+             int64_t{kHillaireTransmittanceWidth} * kHillaireTransmittanceHeight, 64, stage);
     Attach();
 }
 
-// Multiple-scattering table (paper section 5.5.2, Eq. 5-10): see hillaire.h.
+// Multiple-scattering table (paper section 5.5.2, Eq. 5-10): see hillaire.h
+// (HillaireMultipleScatteringStage).
 void HillaireModel::BuildMultipleScattering() {
-    const AtmosphereParameters& atm = evaluator_.atm;
-    HillaireEvaluator e = evaluator_;
-    e.use_multiple_scattering = false;
-    const double p_u = IsotropicPhase();
-    constexpr int kDirs = kHillaireMsSqrtDirections * kHillaireMsSqrtDirections;
     multiple_scattering_.Resize(kHillaireMsSize, kHillaireMsSize, 1, 3);
-    ParallelFor(kHillaireMsSize * kHillaireMsSize, 4, [&](int64_t index) {
-        const int i = static_cast<int>(index % kHillaireMsSize);  // mu_s
-        const int j = static_cast<int>(index / kHillaireMsSize);  // altitude
-        const double mu_s = -1.0 + 2.0 * i / (kHillaireMsSize - 1);
-        const double r =
-            atm.bottom_radius + (atm.top_radius - atm.bottom_radius) * j / (kHillaireMsSize - 1);
-        const Vec3d x(0.0, 0.0, r);
-        const Vec3d sun(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
-        Vec3d l_2nd, f_ms;
-        for (int k = 0; k < kDirs; ++k) {
-            // Stratified uniform directions on the sphere (8 x 8 cells, centres).
-            const double a = (k / kHillaireMsSqrtDirections + 0.5) / kHillaireMsSqrtDirections;
-            const double b = (k % kHillaireMsSqrtDirections + 0.5) / kHillaireMsSqrtDirections;
-            const double phi = 2.0 * kPi * a;
-            const double cos_theta = 1.0 - 2.0 * b;
-            const double sin_theta = SafeSqrt(1.0 - cos_theta * cos_theta);
-            const Vec3d dir(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta);
-            const AtmosphereSegment seg =
-                ClipToAtmosphere(x, dir, atm.bottom_radius, atm.top_radius);
-            Vec3d L, F, T(1.0);
-            if (seg.inside) {
-                const double dt = (seg.t_end - seg.t_start) / kHillaireMsSteps;
-                for (int s = 0; s < kHillaireMsSteps; ++s) {
-                    const Vec3d p = x + dir * (seg.t_start + (s + e.segment_offset) * dt);
-                    const double rp = Length(p);
-                    const Densities d = GetDensities(atm, rp - atm.bottom_radius);
-                    const Vec3d sigma_s =
-                        atm.rayleigh_scattering * d.rayleigh + atm.mie_scattering * d.mie;
-                    const Vec3d sigma_t = Extinction(atm, d);
-                    const Vec3d t_sun = e.SunTransmittance(rp, ClampCosine(Dot(p, sun) / rp));
-                    const Vec3d S = sigma_s * t_sun * p_u;
-                    const Vec3d step_t = Exp(-sigma_t * dt);
-                    for (int c = 0; c < 3; ++c) {
-                        const double w = sigma_t[c] > 0.0 ? (1.0 - step_t[c]) / sigma_t[c] : dt;
-                        L[c] += T[c] * S[c] * w;
-                        F[c] += T[c] * sigma_s[c] * w;
-                    }
-                    T *= step_t;
-                }
-            }
-            if (seg.hits_ground) L += T * e.GroundReflection(x + dir * seg.t_end, sun);
-            l_2nd += L;
-            f_ms += F;
-        }
-        // Uniform sampling of the sphere: int f p_u dw = mean of f.
-        l_2nd = l_2nd / static_cast<double>(kDirs);
-        f_ms = f_ms / static_cast<double>(kDirs);
-        Vec3d psi;
-        for (int c = 0; c < 3; ++c) psi[c] = l_2nd[c] / Max(1.0 - f_ms[c], 1e-6);
-        multiple_scattering_.Set(i, j, 0, ToTexel(psi));
-    });
+    HillaireMultipleScatteringStage stage;
+    stage.e = StageEvaluator();
+    stage.e.use_multiple_scattering = false;
+    stage.e.multiple_scattering = TableView{};  // not read (the table being built)
+    stage.out = multiple_scattering_.out();
+    RunStage("hillaire/multiple-scattering", int64_t{kHillaireMsSize} * kHillaireMsSize, 4, stage);
     Attach();
 }
 
 void HillaireModel::BuildSkyView(double r, double mu_s, Table* table) const {
-    const HillaireEvaluator& e = evaluator_;
-    const AtmosphereParameters& atm = e.atm;
+    const AtmosphereParameters& atm = evaluator_.atm;
     table->Resize(kHillaireSkyViewWidth, kHillaireSkyViewHeight, 1, 3);
     // The table's rays start at least kHillaireSkyViewMinAltitude above the
     // ground, where its horizon angle is taken (else the texel row just above
     // the horizon would start on the ground and read black).
-    r = Max(r, atm.bottom_radius + kHillaireSkyViewMinAltitude);
-    const Vec3d camera(0.0, 0.0, r);
-    const Vec3d sun(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
-    const int n = sky_view_steps_;
-    ParallelFor(kHillaireSkyViewHeight, 1, [&](int64_t j64) {
-        const int j = static_cast<int>(j64);
-        for (int i = 0; i < kHillaireSkyViewWidth; ++i) {
-            double mu_v, cos_az;
-            HillaireSkyViewParams(
-                r, atm.bottom_radius, static_cast<double>(i) / (kHillaireSkyViewWidth - 1),
-                static_cast<double>(j) / (kHillaireSkyViewHeight - 1), &mu_v, &cos_az);
-            const double sin_v = SafeSqrt(1.0 - mu_v * mu_v);
-            const Vec3d dir(sin_v * cos_az, sin_v * SafeSqrt(1.0 - cos_az * cos_az), mu_v);
-            const AtmosphereSegment seg =
-                ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
-            Vec3d L, T(1.0);
-            if (seg.inside) e.Integrate(camera, dir, sun, seg.t_start, seg.t_end, n, &L, &T);
-            table->Set(i, j, 0, ToTexel(L));
-        }
-    });
+    HillaireSkyViewStage stage;
+    stage.e = StageEvaluator();
+    stage.r = Max(r, atm.bottom_radius + kHillaireSkyViewMinAltitude);
+    stage.sun = Vec3d(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
+    stage.steps = sky_view_steps_;
+    stage.out = table->out();
+    RunStage("hillaire/sky-view", int64_t{kHillaireSkyViewWidth} * kHillaireSkyViewHeight, 32,
+             stage);
 }
 
 std::unique_ptr<HillaireFrame> HillaireModel::BuildFrame(const Camera& camera_frame,
@@ -269,47 +200,23 @@ std::unique_ptr<HillaireFrame> HillaireModel::BuildFrame(const Camera& camera_fr
     frame->timings.sky_view_s = SecondsSince(start);
     if (!with_aerial_perspective) return frame;
 
-    // Aerial-perspective volume: one cumulative march per screen texel column.
+    // Aerial-perspective volume: one cumulative march per screen texel column
+    // (HillaireAerialPerspectiveStage).
     start = std::chrono::steady_clock::now();
     frame->base.ap_camera = camera_frame;
     frame->base.ap_aspect = aspect;
-    const double metres_per_slice = evaluator_.ap_metres_per_slice;
-    const int sub = ap_steps_per_slice_;
     frame->ap_scatter.Resize(kHillaireApSize, kHillaireApSize, kHillaireApSize, 3);
     frame->ap_transmittance.Resize(kHillaireApSize, kHillaireApSize, kHillaireApSize, 3);
-    Table& scatter = frame->ap_scatter;
-    Table& trans = frame->ap_transmittance;
-    const HillaireEvaluator& e = evaluator_;
-    ParallelFor(kHillaireApSize * kHillaireApSize, 4, [&](int64_t index) {
-        const int i = static_cast<int>(index % kHillaireApSize);
-        const int j = static_cast<int>(index / kHillaireApSize);
-        const double u = (i + 0.5) / kHillaireApSize;
-        const double v = (j + 0.5) / kHillaireApSize;
-        const double tan_y = camera_frame.tan_half_fov_y;
-        const Vec3d dir = Normalize(camera_frame.forward +
-                                    camera_frame.right * ((2.0 * u - 1.0) * tan_y * aspect) +
-                                    camera_frame.up * ((1.0 - 2.0 * v) * tan_y));
-        // The froxel's ray ignores the ground (points below it are taken at
-        // the ground): a ground ray's value is interpolated between froxel
-        // rays, and a neighbour that stopped at its own ground hit would bias it.
-        double t_in = 0.0, t_out = 0.0;
-        const bool crosses =
-            IntersectSphere(camera, dir, atm.top_radius, &t_in, &t_out) && t_out > 0.0;
-        t_in = Max(t_in, 0.0);
-        Vec3d L, T(1.0);
-        double t_prev = 0.0;
-        for (int k = 0; k < kHillaireApSize; ++k) {
-            const double t_k = HillaireApSliceDistance(k, metres_per_slice);
-            if (crosses) {
-                const double ta = Clamp(t_prev, t_in, t_out);
-                const double tb = Clamp(t_k, t_in, t_out);
-                e.Integrate(camera, dir, sun, ta, tb, sub, &L, &T, true);
-            }
-            t_prev = t_k;
-            scatter.Set(i, j, k, ToTexel(L));
-            trans.Set(i, j, k, ToTexel(T));
-        }
-    });
+    HillaireAerialPerspectiveStage stage;
+    stage.e = StageEvaluator();
+    stage.camera = camera_frame;
+    stage.sun = sun;
+    stage.aspect = aspect;
+    stage.metres_per_slice = evaluator_.ap_metres_per_slice;
+    stage.steps_per_slice = ap_steps_per_slice_;
+    stage.scatter = frame->ap_scatter.out();
+    stage.transmittance = frame->ap_transmittance.out();
+    RunStage("hillaire/aerial-perspective", int64_t{kHillaireApSize} * kHillaireApSize, 4, stage);
     frame->timings.aerial_perspective_s = SecondsSince(start);
     return frame;
 }

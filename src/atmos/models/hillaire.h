@@ -89,6 +89,11 @@
 // the table is relative to the sun's azimuth); no aerial-perspective volume, so
 // ground-hitting rays use the sky-view table's lower half. `--sample-path march`
 // ray marches every query (no per-frame tables).
+//
+// Precomputation: the four tables (transmittance, multiple scattering, and per
+// frame sky-view and aerial perspective) are built by the stage structs of
+// hillaire_stages.h through RunStage: on the CPU, or, on the CUDA backend
+// (`--backend cuda`), on the device from the same code.
 #pragma once
 
 #include <memory>
@@ -463,6 +468,8 @@ class HillaireModel : public Model {
 
   private:
     void Attach();
+    // The evaluator the precomputation stages read (the model's tables only).
+    HillaireEvaluator StageEvaluator() const;
 
     ModelInfo info_;
     HillaireEvaluator evaluator_;
