@@ -78,6 +78,15 @@ struct BrunetonLut {
     TableView scattering_table;     // 3 channels (separate) or 4 (combined)
     TableView single_mie_table;     // 3 channels, separate storage only
 
+    // Names every table (render/stages.h: a stage holding a lut copies these).
+    template <typename V>
+    void VisitTables(V& v) {
+        v(transmittance_table);
+        v(irradiance_table);
+        v(scattering_table);
+        v(single_mie_table);
+    }
+
     // ---- helpers (seed 004, "ClampRadius", distances) ----
     ATMOS_HD double ClampRadius(double r) const {
         return Clamp(r, atm.bottom_radius, atm.top_radius);
