@@ -166,10 +166,15 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
             nu_x[k] = nu;
             BrunetonNuCoordinate(nu, c.scattering_nu, &tex_x[k], &lerp[k]);
         }
+        std::vector<double> u_mu_s(w);
         for (const BrunetonMultipleSample& s : samples) {
+            // First the mu_s coordinates of all texels (a vectorisable loop)...
             for (size_t k = 0; k < w; ++k) {
-                sum[k] += BrunetonMultipleScatteringTerm(fast, s, r, mu_s_x[k], nu_x[k], tex_x[k],
-                                                         lerp[k]);
+                u_mu_s[k] = BrunetonMultipleScatteringUMuS(fast, s, r, mu_s_x[k], nu_x[k]);
+            }
+            // ...then the lookups.
+            for (size_t k = 0; k < w; ++k) {
+                sum[k] += BrunetonMultipleScatteringTerm(fast, s, tex_x[k], lerp[k], u_mu_s[k]);
             }
         }
         for (int x = 0; x < width; ++x) {

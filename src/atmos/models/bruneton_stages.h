@@ -541,7 +541,7 @@ struct BrunetonFastLookup {
 // radius, the (mu, r) rows of the density lookup, and the transmittance from
 // the camera times the trapezoid weight and dx.
 struct BrunetonMultipleSample {
-    double d, r;
+    double d, r, inv_r;
     BrunetonFastLookup::Rows rows;
     Rgb t;
 };
@@ -552,6 +552,7 @@ ATMOS_HD inline BrunetonMultipleSample BrunetonMultipleScatteringSample(
     const double d = i * dx;
     s.d = d;
     s.r = lut.ClampRadius(Sqrt(d * d + 2.0 * r * mu * d + r * r));
+    s.inv_r = 1.0 / s.r;
     const double mu_i = ClampCosine((r * mu + d) / s.r);
     double u_mu, u_r;
     lut.ScatteringUMuR(s.r, mu_i, ground, &u_mu, &u_r);
@@ -566,14 +567,18 @@ ATMOS_HD inline void BrunetonNuCoordinate(double nu, int nu_size, double* tex_x,
     *tex_x = floor(tex_coord_x);
     *lerp = static_cast<float>(tex_coord_x - *tex_x);
 }
-// The (mu_s, nu) part of sample s: the density J_n at the sample.
+// The (mu_s, nu) part of sample s: the mu_s coordinate at the sample (the
+// CPU's rows compute it for a whole row first, a loop that vectorises)...
+ATMOS_HD inline double BrunetonMultipleScatteringUMuS(const BrunetonFastLookup& fast,
+                                                      const BrunetonMultipleSample& s, double r,
+                                                      double mu_s, double nu) {
+    return fast.UMuS(ClampCosine((r * mu_s + s.d * nu) * s.inv_r));
+}
+// ...then the density J_n at the sample times the weighted transmittance.
 ATMOS_HD inline Rgb BrunetonMultipleScatteringTerm(const BrunetonFastLookup& fast,
-                                                   const BrunetonMultipleSample& s, double r,
-                                                   double mu_s, double nu, double tex_x,
-                                                   float lerp) {
-    const double inv_r_i = 1.0 / s.r;
-    const double mu_s_i = ClampCosine((r * mu_s + s.d * nu) * inv_r_i);
-    return fast.SampleRows(s.rows, tex_x, lerp, fast.UMuS(mu_s_i)) * s.t;
+                                                   const BrunetonMultipleSample& s, double tex_x,
+                                                   float lerp, double u_mu_s) {
+    return fast.SampleRows(s.rows, tex_x, lerp, u_mu_s) * s.t;
 }
 
 // Item: texel of the scattering table; writes the multiple scattering of order
@@ -604,7 +609,8 @@ struct BrunetonMultipleScatteringStage {
         for (int i = 0; i <= n; ++i) {
             const BrunetonMultipleSample s =
                 BrunetonMultipleScatteringSample(lut, fast, r, mu, ground, dx, i, n);
-            sum += BrunetonMultipleScatteringTerm(fast, s, r, mu_s, nu, tex_x, lerp);
+            const double u_mu_s = BrunetonMultipleScatteringUMuS(fast, s, r, mu_s, nu);
+            sum += BrunetonMultipleScatteringTerm(fast, s, tex_x, lerp, u_mu_s);
         }
         out.Set(x, y, z, BrunetonVec4(sum));
     }
