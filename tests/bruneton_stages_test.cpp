@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <map>
 #include <string>
 #include <vector>
@@ -230,6 +231,193 @@ TEST(BrunetonStages, EveryStageGoesThroughRunStage) {
     EXPECT_EQ(runs["bruneton scattering density"], c.orders - 1);
     EXPECT_EQ(runs["bruneton accumulate"], c.orders - 1);
     EXPECT_EQ(log.size(), 4u + 6u * static_cast<size_t>(c.orders - 1));
+}
+
+// What RunStage's CUDA backend does to a stage (cuda/stage_launch.cuh), on the
+// host: every table VisitTables names is copied to a new buffer (one copy per
+// distinct pointer) and the stage re-pointed to the copies. Every table of
+// `world` (all the tables the test holds) is then filled with NaN while the
+// items run, and restored; the outputs are copied back. A stage that reads a
+// table it does not name (on the device: host memory) reads NaN.
+class EmulatedDevice {
+  public:
+    template <typename Stage>
+    void Run(int64_t count, Stage stage, const std::vector<Table*>& world) {
+        Repoint repoint{this};
+        stage.VisitTables(repoint);
+        std::vector<std::vector<float>> saved;
+        for (Table* t : world) {
+            saved.emplace_back(t->data(), t->data() + t->size());
+            std::fill(t->data(), t->data() + t->size(), std::nanf(""));
+        }
+        for (int64_t i = 0; i < count; ++i) stage(i);
+        for (size_t k = 0; k < world.size(); ++k) {
+            std::copy(saved[k].begin(), saved[k].end(), world[k]->data());
+        }
+        for (Buffer& b : buffers_) {
+            if (b.output) std::copy(b.copy.begin(), b.copy.end(), b.host);
+        }
+        buffers_.clear();
+    }
+
+  private:
+    struct Buffer {
+        float* host;
+        std::vector<float> copy;
+        bool output;
+    };
+    float* Copy(const float* host, size_t floats, bool output) {
+        if (!host) return nullptr;
+        for (Buffer& b : buffers_) {
+            if (b.host == host) {
+                b.output = b.output || output;
+                return b.copy.data();
+            }
+        }
+        buffers_.push_back(
+            {const_cast<float*>(host), std::vector<float>(host, host + floats), output});
+        return buffers_.back().copy.data();
+    }
+    struct Repoint {
+        EmulatedDevice* device;
+        void operator()(TableView& v) const {
+            v.data = device->Copy(
+                v.data,
+                static_cast<size_t>(v.width) * v.height * v.depth * static_cast<size_t>(v.channels),
+                false);
+        }
+        void operator()(TableOut& o) const { o.data = device->Copy(o.data, o.size(), true); }
+    };
+    std::deque<Buffer> buffers_;  // stable addresses while the stage runs
+};
+
+// Runs `make(out)` on the CPU backend and `make(out_emulated)` through
+// EmulatedDevice (the same table shape and start values), then expects equal,
+// finite tables.
+template <typename MakeStage>
+void ExpectStageNamesItsTables(const char* name, int64_t count, Table* out, Table* out_emulated,
+                               const std::vector<Table*>& world, MakeStage make) {
+    SCOPED_TRACE(name);
+    RunStage(name, count, 16, make(out));
+    std::vector<Table*> others;
+    for (Table* t : world) {
+        if (t != out && t != out_emulated) others.push_back(t);
+    }
+    EmulatedDevice().Run(count, make(out_emulated), others);
+    ASSERT_EQ(out->size(), out_emulated->size());
+    size_t differ = 0, not_finite = 0;
+    for (size_t i = 0; i < out->size(); ++i) {
+        if (!std::isfinite(out_emulated->data()[i])) ++not_finite;
+        if (!(out->data()[i] == out_emulated->data()[i])) ++differ;
+    }
+    EXPECT_EQ(not_finite, 0u);
+    EXPECT_EQ(differ, 0u);
+}
+
+TEST(BrunetonStages, EachStageReadsOnlyTheTablesItNames) {
+    AtmosphereParameters atm = EarthAtmosphere();
+    atm.ground_albedo = Vec3d(0.3, 0.3, 0.3);
+    const BrunetonConfig c = SmallConfig(3);
+    const int width = c.scattering_nu * c.scattering_mu_s;
+    const int64_t texels = static_cast<int64_t>(width) * c.scattering_mu * c.scattering_r;
+    const int64_t irr_texels = static_cast<int64_t>(c.irradiance_width) * c.irradiance_height;
+    BrunetonLut lut;
+    lut.atm = atm;
+    lut.cfg = c;
+    const BrunetonLut mappings = BrunetonMappingsOnly(lut);
+
+    // Every table of the test (pairs: CPU run, emulated run), all poisoned
+    // during each emulated run but the stage's own copies.
+    const Table s3(width, c.scattering_mu, c.scattering_r, 3);
+    const Table irr0(c.irradiance_width, c.irradiance_height, 1, 3);
+    Table t(c.transmittance_width, c.transmittance_height, 1, 3), t2(t);
+    Table e(irr0), e2(irr0), ray(s3), ray2(s3), mie(s3), mie2(s3), single_mie(s3);
+    Table scat(width, c.scattering_mu, c.scattering_r, 4), scat2(scat);
+    Table directions = MakeBrunetonDirectionTable();
+    Table multiple = SyntheticDensity(c);
+    Table inc(3 * kBrunetonDirections, c.scattering_mu_s, c.scattering_r, 1), inc2(inc);
+    Table j(s3), j2(s3), irr(irr0), irr2(irr0), total(irr0), total2(irr0), ms(s3), ms2(s3);
+    Table acc(scat), acc2(scat);
+    const std::vector<Table*> world = {
+        &t,    &t2,    &e,          &e2,       &ray, &ray2, &mie, &mie2, &single_mie,
+        &scat, &scat2, &directions, &multiple, &inc, &inc2, &j,   &j2,   &irr,
+        &irr2, &total, &total2,     &ms,       &ms2, &acc,  &acc2};
+
+    ExpectStageNamesItsTables("transmittance", static_cast<int64_t>(t.width()) * t.height(), &t,
+                              &t2, world, [&](Table* o) {
+                                  return BrunetonTransmittanceStage{mappings, o->out()};
+                              });
+    lut.transmittance_table = t.view();
+
+    ExpectStageNamesItsTables("direct irradiance", irr_texels, &e, &e2, world, [&](Table* o) {
+        return BrunetonDirectIrradianceStage{lut, o->out()};
+    });
+
+    // Single scattering writes two tables: Mie is compared after the call.
+    ExpectStageNamesItsTables("single scattering", texels, &ray, &ray2, world, [&](Table* o) {
+        return BrunetonSingleScatteringStage{lut, o->out(), (o == &ray ? mie : mie2).out()};
+    });
+    EXPECT_TRUE(std::equal(mie.data(), mie.data() + mie.size(), mie2.data()));
+
+    ExpectStageNamesItsTables("combine", texels, &scat, &scat2, world, [&](Table* o) {
+        return BrunetonCombineStage{ray.view(), mie.view(), o->out(), single_mie.out()};
+    });
+
+    for (int order : {2, 3}) {
+        ExpectStageNamesItsTables(
+            "incident", static_cast<int64_t>(kBrunetonDirections) * inc.height() * inc.depth(),
+            &inc, &inc2, world, [&](Table* o) {
+                BrunetonIncidentStage s;
+                s.lut = lut;
+                if (order == 2) {
+                    s.single_rayleigh = ray.view();
+                    s.single_mie = mie.view();
+                } else {
+                    s.multiple = multiple.view();
+                }
+                s.ground_irradiance = e.view();
+                s.directions = directions.view();
+                s.order = order;
+                s.incident = o->out();
+                return s;
+            });
+        ExpectStageNamesItsTables("density", texels, &j, &j2, world, [&](Table* o) {
+            return BrunetonDensityStage{mappings, inc.view(), directions.view(), o->out()};
+        });
+    }
+
+    for (int order : {1, 2}) {
+        ExpectStageNamesItsTables("indirect irradiance", irr_texels, &irr, &irr2, world,
+                                  [&](Table* o) {
+                                      BrunetonIndirectIrradianceStage s;
+                                      s.lut = mappings;
+                                      s.order = order;
+                                      if (order == 1) {
+                                          s.single_rayleigh = ray.view();
+                                          s.single_mie = mie.view();
+                                      } else {
+                                          s.multiple = multiple.view();
+                                      }
+                                      s.out = o->out();
+                                      return s;
+                                  });
+    }
+
+    total = e;
+    total2 = e;
+    ExpectStageNamesItsTables("add", irr_texels, &total, &total2, world, [&](Table* o) {
+        return BrunetonAddStage{e.view(), o->out()};
+    });
+
+    ExpectStageNamesItsTables("multiple scattering", texels, &ms, &ms2, world, [&](Table* o) {
+        return BrunetonMultipleScatteringStage{lut, multiple.view(), o->out()};
+    });
+
+    acc = scat;
+    acc2 = scat;
+    ExpectStageNamesItsTables("accumulate", texels, &acc, &acc2, world, [&](Table* o) {
+        return BrunetonAccumulateStage{mappings, ms.view(), o->out()};
+    });
 }
 
 TEST(BrunetonStages, DirectionTableCoversTheSphere) {
