@@ -231,6 +231,23 @@ TEST(BrunetonStages, EveryStageGoesThroughRunStage) {
     EXPECT_EQ(runs["bruneton scattering density"], c.orders - 1);
     EXPECT_EQ(runs["bruneton accumulate"], c.orders - 1);
     EXPECT_EQ(log.size(), 4u + 6u * static_cast<size_t>(c.orders - 1));
+
+    // The CPU backend's path logs its row forms in their place.
+    log.clear();
+    {
+        const StageLogScope scope(&log);
+        PrecomputeBrunetonWith(EarthAtmosphere(), c, false, &tables);
+    }
+    std::map<std::string, int64_t> row_items;
+    for (const StageTime& s : log) row_items[s.name] = s.items;
+    std::map<std::string, int64_t> expected_rows = expected_items;
+    expected_rows.erase("bruneton single scattering");
+    expected_rows.erase("bruneton multiple scattering");
+    const int64_t rows = static_cast<int64_t>(c.scattering_mu) * c.scattering_r;
+    expected_rows["bruneton single scattering (rows)"] = rows;
+    expected_rows["bruneton multiple scattering (rows)"] = rows;
+    EXPECT_EQ(row_items, expected_rows);
+    EXPECT_EQ(log.size(), 4u + 6u * static_cast<size_t>(c.orders - 1));
 }
 
 // What RunStage's CUDA backend does to a stage (cuda/stage_launch.cuh), on the

@@ -37,6 +37,13 @@ constexpr int kMaxScatteringSamples = 1000;  // seed 004 uses 50 (the default)
 // Rows of the 3D scattering table: one (mu, r) pair = (y, z), NU * MU_S texels.
 int RowCount(const BrunetonConfig& c) { return c.scattering_mu * c.scattering_r; }
 
+// The row forms in the stage log (render/stages.h), like RunStage's CPU runs.
+void LogRows(const char* name, int64_t rows, Clock::time_point start) {
+    if (!CurrentStageLog()) return;
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    LogStage({name, rows, "cpu", ms, ms});
+}
+
 int64_t TexelCount(const Table& t) {
     return static_cast<int64_t>(t.width()) * t.height() * t.depth();
 }
@@ -102,6 +109,7 @@ void ComputeBrunetonSingleScatteringRows(const BrunetonLut& lut, Table* rayleigh
     const int width = c.scattering_nu * c.scattering_mu_s;
     rayleigh->Resize(width, c.scattering_mu, c.scattering_r, 3);
     mie->Resize(width, c.scattering_mu, c.scattering_r, 3);
+    const Clock::time_point start = Clock::now();
     ParallelFor(RowCount(c), 1, [&](int64_t row) {
         const int y = static_cast<int>(row % c.scattering_mu);
         const int z = static_cast<int>(row / c.scattering_mu);
@@ -128,6 +136,7 @@ void ComputeBrunetonSingleScatteringRows(const BrunetonLut& lut, Table* rayleigh
             mie->Set(x, y, z, BrunetonVec4(sum_m * beta_m));
         }
     });
+    LogRows("bruneton single scattering (rows)", RowCount(c), start);
 }
 
 // Per row (r, mu): the samples' transmittance from the camera and the (mu, r)
@@ -139,6 +148,7 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
     const int width = c.scattering_nu * c.scattering_mu_s;
     out->Resize(width, c.scattering_mu, c.scattering_r, 3);
     const BrunetonFastLookup fast(lut, density);
+    const Clock::time_point start = Clock::now();
     ParallelFor(RowCount(c), 1, [&](int64_t row) {
         const int y = static_cast<int>(row % c.scattering_mu);
         const int z = static_cast<int>(row / c.scattering_mu);
@@ -181,6 +191,7 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
             out->Set(x, y, z, BrunetonVec4(sum[static_cast<size_t>(x)]));
         }
     });
+    LogRows("bruneton multiple scattering (rows)", RowCount(c), start);
 }
 
 void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
