@@ -3,7 +3,8 @@
 //
 // Run: build/bench/atmos_bench --benchmark_filter=Bruneton
 // BM_BrunetonPrecompute/ORDERS/THREADS reports the stages (seconds, wall clock)
-// as counters.
+// as counters; BM_BrunetonPrecomputeTexelStages/ORDERS/THREADS the same with every
+// stage per texel (the CUDA backend's stages) on the CPU.
 #include <benchmark/benchmark.h>
 
 #include <string>
@@ -14,12 +15,15 @@
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "models/bruneton.h"
+#include "models/bruneton_stages.h"
 #include "render/render.h"
 
 namespace atmos {
 namespace {
 
-void BM_BrunetonPrecompute(benchmark::State& state) {
+// texel_stages: every stage per texel (models/bruneton_stages.h: what the CUDA
+// backend runs), here on the CPU; otherwise the CPU backend's path.
+void Precompute(benchmark::State& state, bool texel_stages) {
     BrunetonConfig config;
     config.orders = static_cast<int>(state.range(0));
     ThreadLimit limit(static_cast<int>(state.range(1)));
@@ -27,7 +31,7 @@ void BM_BrunetonPrecompute(benchmark::State& state) {
     BrunetonTimings t;
     for (auto _ : state) {
         BrunetonTables tables;
-        PrecomputeBruneton(atm, config, &tables, &t);
+        PrecomputeBrunetonWith(atm, config, texel_stages, &tables, &t);
         benchmark::DoNotOptimize(tables.scattering.data());
     }
     // Wall clock, and CPU time of all threads (the machine may be shared).
@@ -43,10 +47,17 @@ void BM_BrunetonPrecompute(benchmark::State& state) {
         state.counters[p + "total"] = s.total;
     }
 }
+void BM_BrunetonPrecompute(benchmark::State& state) { Precompute(state, false); }
+void BM_BrunetonPrecomputeTexelStages(benchmark::State& state) { Precompute(state, true); }
 // Args: orders, threads (0: all cores).
 BENCHMARK(BM_BrunetonPrecompute)
     ->Args({4, 2})
     ->Args({4, 1})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+BENCHMARK(BM_BrunetonPrecomputeTexelStages)
+    ->Args({4, 2})
     ->Unit(benchmark::kSecond)
     ->Iterations(1)
     ->UseRealTime();

@@ -18,6 +18,8 @@
 //   Mie storage: its own table (default) or combined (red in the alpha channel of
 //   the scattering table, green and blue extrapolated, seed 004
 //   GetExtrapolatedSingleMieScattering).
+//   The precomputation's steps are stage structs (models/bruneton_stages.h)
+//   that RunStage runs on the CPU or, on the CUDA backend, on the device.
 //
 // Output: radiance per unit solar irradiance (1/sr): the tables are computed
 // with solar irradiance 1 (the render loop multiplies by the atmosphere's), and
@@ -77,6 +79,15 @@ struct BrunetonLut {
     TableView irradiance_table;     // 3 channels (indirect only, as the seed)
     TableView scattering_table;     // 3 channels (separate) or 4 (combined)
     TableView single_mie_table;     // 3 channels, separate storage only
+
+    // Names every table (render/stages.h: a stage holding a lut copies these).
+    template <typename V>
+    void VisitTables(V& v) {
+        v(transmittance_table);
+        v(irradiance_table);
+        v(scattering_table);
+        v(single_mie_table);
+    }
 
     // ---- helpers (seed 004, "ClampRadius", distances) ----
     ATMOS_HD double ClampRadius(double r) const {
@@ -479,7 +490,8 @@ struct BrunetonTables {
     Table single_mie;     // same size, 3 channels (separate storage), else empty
 };
 
-// Seconds per precomputation stage.
+// Seconds per precomputation stage (wall: on the CUDA backend with the copies
+// to and from the device; the kernels alone are in the stage log, StageLogScope).
 struct BrunetonStageTimes {
     double transmittance = 0.0;
     double direct_irradiance = 0.0;
@@ -499,8 +511,10 @@ struct BrunetonTimings {
 using BrunetonOrderCallback =
     std::function<void(int order, const BrunetonTables& tables, const Table* density)>;
 
-// The whole precomputation of seed 004 on the CPU (ParallelFor). Tables are per
-// unit solar irradiance. Throws atmos::Error for an invalid configuration.
+// The whole precomputation of seed 004, stage by stage through RunStage
+// (models/bruneton_stages.h): on the CPU (ParallelFor) or, on the CUDA backend,
+// on the device. Tables are per unit solar irradiance. Throws atmos::Error for
+// an invalid configuration.
 void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
                         BrunetonTables* tables, BrunetonTimings* timings = nullptr,
                         const BrunetonOrderCallback& on_order = nullptr);
