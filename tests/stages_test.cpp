@@ -37,7 +37,7 @@ TEST(Stages, RunStageVisitsEveryItemOnceOnTheCpuAndLogsIt) {
     std::vector<StageTime> log;
     {
         const StageLogScope scope(&log);
-        RunStage("scale-add", 35, 3, ScaleAddStage{in.view(), out.out()});
+        RunStage("scale-add", 35, 3, ScaleAddStage{in.view(), out.out(true)});
     }
     for (int y = 0; y < 5; ++y) {
         for (int x = 0; x < 7; ++x) {
@@ -52,7 +52,7 @@ TEST(Stages, RunStageVisitsEveryItemOnceOnTheCpuAndLogsIt) {
     EXPECT_EQ(log[0].backend, "cpu");
     EXPECT_GE(log[0].kernel_ms, 0.0);
     // Without a scope nothing is logged; an empty range does nothing.
-    RunStage("scale-add", 35, 3, ScaleAddStage{in.view(), out.out()});
+    RunStage("scale-add", 35, 3, ScaleAddStage{in.view(), out.out(true)});
     RunStage("none", 0, 1, ScaleAddStage{in.view(), out.out()});
     EXPECT_EQ(log.size(), 1u);
 }

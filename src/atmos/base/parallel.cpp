@@ -62,7 +62,16 @@ Backend ParseBackend(const std::string& text) {
     Fail("unknown backend '", text, "': expected cpu or cuda");
 }
 
-const char* BackendName(Backend backend) { return backend == Backend::kCuda ? "cuda" : "cpu"; }
+const char* BackendName(Backend backend) {
+    switch (backend) {
+        case Backend::kCuda:
+            return "cuda";
+        case Backend::kEmulatedDevice:
+            return "emulated-device";
+        default:
+            return "cpu";
+    }
+}
 
 bool HasCudaSupport() {
 #if defined(ATMOS_HAS_CUDA)
@@ -73,7 +82,7 @@ bool HasCudaSupport() {
 }
 
 void CheckBackendAvailable(Backend backend) {
-    if (backend == Backend::kCpu) return;
+    if (backend != Backend::kCuda) return;
 #if defined(ATMOS_HAS_CUDA)
     cuda::RequireDevice();
 #else

@@ -42,7 +42,12 @@ void ParallelFor(int64_t count, int64_t grain, const std::function<void(int64_t)
 void ParallelForTiles(int width, int height, int tile,
                       const std::function<void(int, int, int, int)>& body);
 
-enum class Backend { kCpu, kCuda };
+// kEmulatedDevice: tests only (not a command-line choice): renders run on the
+// CPU, precomputation stages run the CUDA backend's bookkeeping with host memory
+// standing in for the device (render/stages.h).
+enum class Backend { kCpu, kCuda, kEmulatedDevice };
+// True for the backends whose precomputations keep tables in device copies.
+inline bool IsDeviceBackend(Backend backend) { return backend != Backend::kCpu; }
 
 // "cpu" | "cuda"; throws atmos::Error otherwise.
 Backend ParseBackend(const std::string& text);

@@ -8,7 +8,9 @@
 // centres so that the first and last texels hold the range's end points.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "atmos/math.h"
@@ -41,6 +43,9 @@ struct TableView {
     const float* data = nullptr;
     int width = 0, height = 1, depth = 1;
     int channels = 4;
+    // The Table's identity (Table::id()), 0 for a view of other memory: the
+    // precomputation loop (render/stages.h) keys device copies by it.
+    uint64_t id = 0;
 
     ATMOS_HD Vec4f Fetch(int x, int y, int z = 0) const {
         x = Clamp(x, 0, width - 1);
@@ -94,6 +99,11 @@ struct TableOut {
     float* data = nullptr;
     int width = 0, height = 1, depth = 1;
     int channels = 4;
+    uint64_t id = 0;  // as TableView::id
+    // False (the default): the stage writes every texel of it and reads none,
+    // so a device copy needs no upload. True: the stage reads it too
+    // (accumulates into it).
+    bool accumulate = false;
 
     ATMOS_HD size_t Offset(int x, int y, int z = 0) const {
         return ((static_cast<size_t>(z) * height + y) * width + x) * static_cast<size_t>(channels);
@@ -110,10 +120,12 @@ struct TableOut {
         return static_cast<size_t>(width) * height * depth * static_cast<size_t>(channels);
     }
     // The same table, read-only.
-    ATMOS_HD TableView view() const { return {data, width, height, depth, channels}; }
+    ATMOS_HD TableView view() const { return {data, width, height, depth, channels, id}; }
 };
 
-// A host-owned table.
+// A host-owned table. Its id() is unique in the process and changes whenever
+// its storage is replaced (Resize, copy, assignment), never by writes through
+// data() / Texel() / Set().
 class Table {
   public:
     Table() = default;
@@ -127,29 +139,47 @@ class Table {
         view_.channels = channels;
         data_.assign(static_cast<size_t>(width) * height * depth * channels, 0.0f);
         view_.data = data_.data();
+        view_.id = NewId();
     }
-    Table(const Table& o) : data_(o.data_), view_(o.view_) { view_.data = data_.data(); }
+    Table(const Table& o) : data_(o.data_), view_(o.view_) {
+        view_.data = data_.data();
+        view_.id = NewId();
+    }
     Table& operator=(const Table& o) {
         data_ = o.data_;
         view_ = o.view_;
         view_.data = data_.data();
+        view_.id = NewId();
         return *this;
     }
+    // A move keeps the storage, hence the id; the source is left empty.
     Table(Table&& o) noexcept : data_(std::move(o.data_)), view_(o.view_) {
         view_.data = data_.data();
+        o.view_ = TableView();
     }
     Table& operator=(Table&& o) noexcept {
         data_ = std::move(o.data_);
         view_ = o.view_;
         view_.data = data_.data();
+        o.view_ = TableView();
         return *this;
     }
 
     const TableView& view() const { return view_; }
-    // A writable view (valid until the next Resize or assignment).
-    TableOut out() {
-        return {data_.data(), view_.width, view_.height, view_.depth, view_.channels};
+    // A writable view (valid until the next Resize or assignment); `accumulate`:
+    // see TableOut.
+    TableOut out(bool accumulate = false) {
+        TableOut o;
+        o.data = data_.data();
+        o.width = view_.width;
+        o.height = view_.height;
+        o.depth = view_.depth;
+        o.channels = view_.channels;
+        o.id = view_.id;
+        o.accumulate = accumulate;
+        return o;
     }
+    uint64_t id() const { return view_.id; }
     int width() const { return view_.width; }
     int height() const { return view_.height; }
     int depth() const { return view_.depth; }
@@ -168,6 +198,10 @@ class Table {
     }
 
   private:
+    static uint64_t NewId() {
+        static std::atomic<uint64_t> next{1};
+        return next.fetch_add(1);
+    }
     std::vector<float> data_;
     TableView view_;
 };

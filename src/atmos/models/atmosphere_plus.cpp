@@ -46,6 +46,9 @@ AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings
     s.mapping.height = atm.top_radius - atm.bottom_radius;
     CheckSettings(s);
     AplusTables out;
+    // On a device backend every table stays on the device between the stages;
+    // the host gets the orders it copies and the final tables (Download).
+    StageSession session;
     auto start = std::chrono::steady_clock::now();
     out.transmittance = Table(s.transmittance_width, s.transmittance_height, 1, 3);
     RunStage("atmosphere-plus/transmittance",
@@ -59,6 +62,7 @@ AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings
     start = std::chrono::steady_clock::now();
     Table order(s.width, s.height, s.depth, 4);
     RunStage("atmosphere-plus/order-1", count, 16, AplusSingleScatteringStage{atm, s, order.out()});
+    session.Download(&order);
     out.scattering = order;
     out.order_seconds.push_back(SecondsSince(start));
     if (keep_orders) out.orders.push_back(order);
@@ -73,11 +77,16 @@ AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings
         RunStage("atmosphere-plus/order-k", count, 16,
                  AplusOrderStage{atm, s, gather.view(), next.out()});
         RunStage("atmosphere-plus/sum", count, 4096,
-                 AplusAddStage{next.view(), out.scattering.out()});
+                 AplusAddStage{next.view(), out.scattering.out(true)});
         order = std::move(next);
+        if (keep_orders) {
+            session.Download(&order);
+            out.orders.push_back(order);
+        }
         out.order_seconds.push_back(SecondsSince(start));
-        if (keep_orders) out.orders.push_back(order);
     }
+    session.Download(&out.transmittance);
+    session.Download(&out.scattering);
     return out;
 }
 

@@ -197,7 +197,7 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
 void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
                         BrunetonTables* tables, BrunetonTimings* timings,
                         const BrunetonOrderCallback& on_order) {
-    PrecomputeBrunetonWith(atmosphere, config, CurrentBackend() == Backend::kCuda, tables, timings,
+    PrecomputeBrunetonWith(atmosphere, config, IsDeviceBackend(CurrentBackend()), tables, timings,
                            on_order);
 }
 
@@ -212,6 +212,16 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
     lut.cfg = config;
     const BrunetonLut mappings = BrunetonMappingsOnly(lut);
     const int width = config.scattering_nu * config.scattering_mu_s;
+    // On a device backend all tables stay on the device between the stages;
+    // the host gets the final tables, and the tables on_order reads, by Download.
+    StageSession session;
+    const auto download = [&](Table* delta_density) {
+        session.Download(&tables->transmittance);
+        session.Download(&tables->irradiance);
+        session.Download(&tables->scattering);
+        session.Download(&tables->single_mie);
+        if (delta_density) session.Download(delta_density);
+    };
 
     Stopwatch stage;
     tables->transmittance.Resize(config.transmittance_width, config.transmittance_height, 1, 3);
@@ -251,7 +261,10 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
              BrunetonCombineStage{delta_rayleigh.view(), delta_mie.view(), tables->scattering.out(),
                                   config.combined_mie ? TableOut() : tables->single_mie.out()});
     stage.AddTo(&t, &BrunetonStageTimes::single_scattering);
-    if (on_order) on_order(1, *tables, nullptr);
+    if (on_order) {
+        download(nullptr);
+        on_order(1, *tables, nullptr);
+    }
 
     const Table directions = MakeBrunetonDirectionTable();
     Table incident, delta_multiple, delta_density;
@@ -299,7 +312,7 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
         irr.out = delta_irradiance.out();
         RunStage("bruneton indirect irradiance", TexelCount(delta_irradiance), 4, irr);
         RunStage("bruneton add irradiance", TexelCount(delta_irradiance), config.irradiance_width,
-                 BrunetonAddStage{delta_irradiance.view(), tables->irradiance.out()});
+                 BrunetonAddStage{delta_irradiance.view(), tables->irradiance.out(true)});
         stage.AddTo(&t, &BrunetonStageTimes::indirect_irradiance);
 
         stage = Stopwatch();
@@ -315,10 +328,14 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
         // multiplies the whole table by it; seed 004 "Rendering").
         RunStage(
             "bruneton accumulate", TexelCount(delta_multiple), width,
-            BrunetonAccumulateStage{mappings, delta_multiple.view(), tables->scattering.out()});
+            BrunetonAccumulateStage{mappings, delta_multiple.view(), tables->scattering.out(true)});
         stage.AddTo(&t, &BrunetonStageTimes::multiple_scattering);
-        if (on_order) on_order(order, *tables, &delta_density);
+        if (on_order) {
+            download(&delta_density);
+            on_order(order, *tables, &delta_density);
+        }
     }
+    download(nullptr);
     start.AddTo(&t, &BrunetonStageTimes::total);
     if (timings) *timings = t;
 }

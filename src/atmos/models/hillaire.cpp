@@ -126,11 +126,16 @@ void HillaireModel::Attach() {
 void HillaireModel::Prepare(const AtmosphereParameters& atmosphere) {
     ValidateAtmosphere(atmosphere);
     evaluator_.atm = atmosphere;
+    // On a device backend the transmittance table stays on the device for the
+    // multiple-scattering stage; both come back at the end.
+    StageSession session;
     auto start = std::chrono::steady_clock::now();
     BuildTransmittance();
     prepare_timings_.transmittance_s = SecondsSince(start);
     start = std::chrono::steady_clock::now();
     BuildMultipleScattering();
+    session.Download(&transmittance_);
+    session.Download(&multiple_scattering_);
     prepare_timings_.multiple_scattering_s = SecondsSince(start);
 }
 
@@ -195,10 +200,14 @@ std::unique_ptr<HillaireFrame> HillaireModel::BuildFrame(const Camera& camera_fr
     const double r = Length(camera);
     if (!(r <= atm.top_radius) || !transmittance_.size()) return frame;  // ray march
     const double mu_s = ClampCosine(Dot(sun, camera) / r);
+    StageSession session;  // the model's tables are uploaded once for both stages
     auto start = std::chrono::steady_clock::now();
     BuildSkyView(r, mu_s, &frame->sky_view);
     frame->timings.sky_view_s = SecondsSince(start);
-    if (!with_aerial_perspective) return frame;
+    if (!with_aerial_perspective) {
+        session.Download(&frame->sky_view);
+        return frame;
+    }
 
     // Aerial-perspective volume: one cumulative march per screen texel column
     // (HillaireAerialPerspectiveStage).
@@ -217,6 +226,9 @@ std::unique_ptr<HillaireFrame> HillaireModel::BuildFrame(const Camera& camera_fr
     stage.scatter = frame->ap_scatter.out();
     stage.transmittance = frame->ap_transmittance.out();
     RunStage("hillaire/aerial-perspective", int64_t{kHillaireApSize} * kHillaireApSize, 4, stage);
+    session.Download(&frame->sky_view);
+    session.Download(&frame->ap_scatter);
+    session.Download(&frame->ap_transmittance);
     frame->timings.aerial_perspective_s = SecondsSince(start);
     return frame;
 }

@@ -1,0 +1,245 @@
+// The device bookkeeping of the precomputation loop (render/stages.h), run on
+// the CPU: Backend::kEmulatedDevice keeps "device" copies in host memory with
+// the CUDA backend's rules (device copies kept between stages of a
+// StageSession, whole outputs not uploaded, host copies stale until Download),
+// poisoning with NaN whatever the device would not have. Every table-building
+// model, run so, must give the CPU backend's tables bit for bit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "atmos/atmosphere.h"
+#include "atmos/error.h"
+#include "atmos/model.h"
+#include "atmos/view.h"
+#include "base/parallel.h"
+#include "base/texture.h"
+#include "models/atmosphere_plus.h"
+#include "models/bruneton.h"
+#include "models/bruneton_stages.h"
+#include "models/hillaire.h"
+#include "render/stages.h"
+
+namespace atmos {
+namespace {
+
+// out = 2 * in (whole output).
+struct DoubleStage {
+    TableView in;
+    TableOut out;
+    template <typename V>
+    void VisitTables(V& v) {
+        v(in);
+        v(out);
+    }
+    ATMOS_HD void operator()(int64_t i) const { out.data[i] = 2.0f * in.data[i]; }
+};
+
+// out += in (accumulated output).
+struct AddStage {
+    TableView in;
+    TableOut out;
+    template <typename V>
+    void VisitTables(V& v) {
+        v(in);
+        v(out);
+    }
+    ATMOS_HD void operator()(int64_t i) const { out.data[i] += in.data[i]; }
+};
+
+// Writes only even items of a whole output.
+struct HalfStage {
+    TableOut out;
+    template <typename V>
+    void VisitTables(V& v) {
+        v(out);
+    }
+    ATMOS_HD void operator()(int64_t i) const {
+        if (i % 2 == 0) out.data[i] = 1.0f;
+    }
+};
+
+Table Filled(int n, float first) {
+    Table t(n, 1, 1, 1);
+    for (int i = 0; i < n; ++i) t.data()[i] = first + static_cast<float>(i);
+    return t;
+}
+
+bool AllNan(const Table& t) {
+    for (size_t i = 0; i < t.size(); ++i) {
+        if (!std::isnan(t.data()[i])) return false;
+    }
+    return true;
+}
+
+bool SameBits(const Table& a, const Table& b) {
+    return a.size() == b.size() &&
+           std::equal(a.data(), a.data() + a.size(), b.data(),
+                      [](float x, float y) { return x == y || (std::isnan(x) && std::isnan(y)); });
+}
+
+TEST(EmulatedDevice, WithoutASessionEachRunCopiesItsOutputsBack) {
+    const BackendScope scope(Backend::kEmulatedDevice);
+    const Table in = Filled(8, 1.0f);
+    Table out(8, 1, 1, 1);
+    RunStage("double", 8, 1, DoubleStage{in.view(), out.out()});
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(out.data()[i], 2.0f * (1.0f + i));
+    RunStage("add", 8, 1, AddStage{in.view(), out.out(true)});
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(out.data()[i], 3.0f * (1.0f + i));
+    // A whole output starts undefined on the device (NaN here): texels a stage
+    // leaves unwritten come back NaN...
+    Table half(8, 1, 1, 1);
+    RunStage("half", 8, 1, HalfStage{half.out()});
+    EXPECT_EQ(half.data()[0], 1.0f);
+    EXPECT_TRUE(std::isnan(half.data()[1]));
+    // ...and so does accumulating into an output not declared `accumulate`.
+    Table wrong = Filled(8, 1.0f);
+    RunStage("add", 8, 1, AddStage{in.view(), wrong.out()});
+    EXPECT_TRUE(AllNan(wrong));
+}
+
+TEST(EmulatedDevice, ASessionKeepsTablesOnTheDeviceUntilDownload) {
+    const BackendScope scope(Backend::kEmulatedDevice);
+    const Table in = Filled(1000, 0.0f);
+    Table mid(1000, 1, 1, 1), out(1000, 1, 1, 1);
+    StageSession session;
+    RunStage("double", 1000, 16, DoubleStage{in.view(), mid.out()});
+    EXPECT_EQ(session.uploaded_bytes(), 4000);  // `in` only: `mid` is a whole output
+    EXPECT_TRUE(AllNan(mid));                   // the host copy is stale until Download
+    RunStage("double", 1000, 16, DoubleStage{mid.view(), out.out()});
+    EXPECT_EQ(session.uploaded_bytes(), 4000);  // `mid` was already on the device
+    EXPECT_EQ(session.downloaded_bytes(), 0);
+    session.Download(&out);
+    EXPECT_EQ(session.downloaded_bytes(), 4000);
+    for (int i = 0; i < 1000; ++i) EXPECT_EQ(out.data()[i], 4.0f * i);
+    EXPECT_TRUE(AllNan(mid));  // never downloaded: never copied
+    session.Download(&mid);
+    EXPECT_EQ(mid.data()[10], 20.0f);
+}
+
+TEST(EmulatedDevice, AHostWriteNeedsHostWroteAndAResizeMakesANewTable) {
+    const BackendScope scope(Backend::kEmulatedDevice);
+    Table in = Filled(16, 1.0f);
+    Table out(16, 1, 1, 1);
+    StageSession session;
+    RunStage("double", 16, 1, DoubleStage{in.view(), out.out()});
+    in.data()[3] = 100.0f;  // the device copy of `in` is now stale
+    try {
+        RunStage("double", 16, 1, DoubleStage{in.view(), out.out()});
+        ADD_FAILURE() << "a host write without HostWrote was not caught";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("HostWrote"), std::string::npos) << e.what();
+    }
+    session.HostWrote(in);
+    RunStage("double", 16, 1, DoubleStage{in.view(), out.out()});
+    session.Download(&out);
+    EXPECT_EQ(out.data()[3], 200.0f);
+    // New storage (a new id) is a new table: uploaded afresh, no HostWrote needed.
+    const uint64_t id = in.id();
+    in = Filled(16, 5.0f);
+    EXPECT_NE(in.id(), id);
+    RunStage("double", 16, 1, DoubleStage{in.view(), out.out()});
+    session.Download(&out);
+    EXPECT_EQ(out.data()[0], 10.0f);
+    // Writing a table whose device copy is newer would lose the device's values.
+    RunStage("double", 16, 1, DoubleStage{in.view(), out.out()});
+    EXPECT_THROW(session.HostWrote(out), Error);
+}
+
+// The models: tables built on the emulated device equal the CPU's bit for bit.
+
+TEST(EmulatedDevice, HillaireTablesAndFrameMatchTheCpu) {
+    const AtmosphereParameters atm = EarthAtmosphere();
+    HillaireModel cpu(ModelOptions("hillaire", HillaireModel::StaticInfo().options, {}));
+    HillaireModel dev(ModelOptions("hillaire", HillaireModel::StaticInfo().options, {}));
+    cpu.Prepare(atm);
+    {
+        const BackendScope scope(Backend::kEmulatedDevice);
+        dev.Prepare(atm);
+    }
+    EXPECT_TRUE(SameBits(cpu.transmittance_table(), dev.transmittance_table()));
+    EXPECT_TRUE(SameBits(cpu.multiple_scattering_table(), dev.multiple_scattering_table()));
+    const View view = GetView("plane-sunrise", atm);
+    const auto a = cpu.BuildFrame(view.camera, view.sun_direction, 16.0 / 9.0);
+    std::unique_ptr<HillaireFrame> b;
+    {
+        const BackendScope scope(Backend::kEmulatedDevice);
+        b = dev.BuildFrame(view.camera, view.sun_direction, 16.0 / 9.0);
+    }
+    EXPECT_TRUE(SameBits(a->sky_view, b->sky_view));
+    EXPECT_TRUE(SameBits(a->ap_scatter, b->ap_scatter));
+    EXPECT_TRUE(SameBits(a->ap_transmittance, b->ap_transmittance));
+}
+
+TEST(EmulatedDevice, AtmospherePlusTablesMatchTheCpu) {
+    const AtmosphereParameters atm = EarthAtmosphere();
+    AplusSettings s;
+    s.width = 8;
+    s.height = 16;
+    s.depth = 8;
+    s.orders = 3;
+    const AplusTables cpu = AplusPrecompute(atm, s, true);
+    AplusTables dev;
+    {
+        const BackendScope scope(Backend::kEmulatedDevice);
+        dev = AplusPrecompute(atm, s, true);
+    }
+    EXPECT_TRUE(SameBits(cpu.transmittance, dev.transmittance));
+    EXPECT_TRUE(SameBits(cpu.scattering, dev.scattering));
+    ASSERT_EQ(cpu.orders.size(), dev.orders.size());
+    for (size_t k = 0; k < cpu.orders.size(); ++k) {
+        EXPECT_TRUE(SameBits(cpu.orders[k], dev.orders[k])) << "order " << k + 1;
+    }
+}
+
+// Bruneton on a device runs every stage per texel: the emulated device must
+// give the CPU's per-texel path exactly (and, through the tests of
+// bruneton_stages_test.cpp, the CPU's row path to rounding).
+TEST(EmulatedDevice, BrunetonTablesMatchTheCpuTexelPath) {
+    AtmosphereParameters atm = EarthAtmosphere();
+    atm.ground_albedo = Vec3d(0.3);
+    BrunetonConfig c;
+    c.transmittance_width = 32;
+    c.transmittance_height = 8;
+    c.irradiance_width = 16;
+    c.irradiance_height = 4;
+    c.scattering_r = 4;
+    c.scattering_mu = 16;
+    c.scattering_mu_s = 8;
+    c.scattering_nu = 4;
+    c.orders = 3;
+    for (bool combined : {false, true}) {
+        SCOPED_TRACE(combined ? "combined Mie" : "separate Mie");
+        c.combined_mie = combined;
+        BrunetonTables cpu, dev;
+        std::vector<Table> cpu_density, dev_density;
+        PrecomputeBrunetonWith(atm, c, true, &cpu, nullptr,
+                               [&](int, const BrunetonTables&, const Table* density) {
+                                   if (density) cpu_density.push_back(*density);
+                               });
+        {
+            const BackendScope scope(Backend::kEmulatedDevice);
+            PrecomputeBruneton(atm, c, &dev, nullptr,
+                               [&](int, const BrunetonTables&, const Table* density) {
+                                   if (density) dev_density.push_back(*density);
+                               });
+        }
+        EXPECT_TRUE(SameBits(cpu.transmittance, dev.transmittance));
+        EXPECT_TRUE(SameBits(cpu.irradiance, dev.irradiance));
+        EXPECT_TRUE(SameBits(cpu.scattering, dev.scattering));
+        EXPECT_TRUE(SameBits(cpu.single_mie, dev.single_mie));
+        ASSERT_EQ(cpu_density.size(), dev_density.size());
+        for (size_t k = 0; k < cpu_density.size(); ++k) {
+            EXPECT_TRUE(SameBits(cpu_density[k], dev_density[k])) << "order " << k + 2;
+        }
+        for (size_t i = 0; i < dev.scattering.size(); ++i) {
+            ASSERT_TRUE(std::isfinite(dev.scattering.data()[i])) << i;
+        }
+    }
+}
+
+}  // namespace
+}  // namespace atmos
