@@ -89,6 +89,7 @@ struct StageRuns {
     std::string name, backend;
     int64_t items = 0;
     std::vector<double> kernel_ms, total_ms;
+    int64_t bytes_up = 0, bytes_down = 0;  // of the last run
 };
 void AddStageRuns(const std::vector<StageTime>& log, std::vector<StageRuns>* runs) {
     for (const StageTime& t : log) {
@@ -102,6 +103,8 @@ void AddStageRuns(const std::vector<StageTime>& log, std::vector<StageRuns>* run
         }
         r->kernel_ms.push_back(t.kernel_ms);
         r->total_ms.push_back(t.total_ms);
+        r->bytes_up = t.bytes_up;
+        r->bytes_down = t.bytes_down;
     }
 }
 
@@ -161,17 +164,24 @@ int CmdBench(const BenchOptions& o) {
                                               .string();
     std::ofstream stages_csv(stages_path);
     if (!stages_csv) Fail("cannot write '", stages_path, "'");
-    stages_csv << "model,view,stage,items,backend,runs,kernel_median_ms,total_median_ms\n";
+    stages_csv << "model,view,stage,items,backend,runs,kernel_median_ms,total_median_ms,bytes_up,"
+                  "bytes_down\n";
     auto write_stages = [&](const std::string& model, const std::string& view,
                             const std::vector<StageRuns>& runs) {
         for (const StageRuns& r : runs) {
             const double k = Median(r.kernel_ms), t = Median(r.total_ms);
             stages_csv << model << "," << view << "," << CsvField(r.name) << "," << r.items << ","
-                       << r.backend << "," << r.kernel_ms.size() << "," << k << "," << t << "\n";
+                       << r.backend << "," << r.kernel_ms.size() << "," << k << "," << t << ","
+                       << r.bytes_up << "," << r.bytes_down << "\n";
             std::printf(
-                "  stage %-34s %10lld items %10.3f ms kernel %10.3f ms total (%s, %zu runs)\n",
+                "  stage %-34s %10lld items %10.3f ms kernel %10.3f ms total (%s, %zu runs)",
                 r.name.c_str(), static_cast<long long>(r.items), k, t, r.backend.c_str(),
                 r.kernel_ms.size());
+            if (r.bytes_up || r.bytes_down) {
+                std::printf(" %.2f MB up %.2f MB down", 1e-6 * static_cast<double>(r.bytes_up),
+                            1e-6 * static_cast<double>(r.bytes_down));
+            }
+            std::printf("\n");
         }
     };
     std::printf("%-20s %-22s %12s %12s %12s %12s %10s\n", "model", "view", "prepare_ms",

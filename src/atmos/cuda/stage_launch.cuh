@@ -50,7 +50,8 @@ void RunStageDevice(const char* name, int64_t count, const Stage& stage) {
         const double total_ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
-        LogStage({name, count, "cuda", static_cast<double>(kernel_ms), total_ms});
+        LogStage({name, count, "cuda", static_cast<double>(kernel_ms), total_ms, binding.bytes_up(),
+                  binding.bytes_down()});
     }
 }
 

@@ -84,6 +84,13 @@ StageSession::~StageSession() {
     g_session.store(previous_);
     if (memory_) {
         for (Entry& e : entries_) memory_->Free(e.device);
+        if (CurrentStageLog() && session_downloads_ > 0) {
+            StageTime t;
+            t.name = "downloads";
+            t.backend = memory_->emulated() ? "emulated-device" : "cuda";
+            t.bytes_down = session_downloads_;
+            LogStage(t);
+        }
     }
 }
 
@@ -100,6 +107,7 @@ void StageSession::Download(Table* table) {
     if (!e || !e->device_newer) return;
     memory_->Download(table->data(), e->device, e->floats);
     downloaded_bytes_ += static_cast<int64_t>(e->floats * sizeof(float));
+    session_downloads_ += static_cast<int64_t>(e->floats * sizeof(float));
     e->device_newer = false;
 }
 

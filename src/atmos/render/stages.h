@@ -78,6 +78,10 @@ struct StageTime {
     std::string backend;     // "cpu", "cuda" or "emulated-device"
     double kernel_ms = 0.0;  // CPU: the ParallelFor; CUDA: between events around the kernel
     double total_ms = 0.0;   // CUDA: with the copies to and from the device
+    // Device backends: bytes copied to / from the device by this run (a
+    // session's later Download() calls are logged as one "downloads" entry
+    // when the session ends).
+    int64_t bytes_up = 0, bytes_down = 0;
 };
 
 // Installs a log that every RunStage appends to while it lives (process-wide;
@@ -156,6 +160,7 @@ class StageSession {
         bool device_newer;
     };
     Entry* Find(const float* host, uint64_t id);
+    int64_t session_downloads_ = 0;  // bytes of Download() calls (logged at the end)
     std::unique_ptr<StageMemory> memory_;
     std::vector<Entry> entries_;
     StageSession* previous_ = nullptr;
@@ -199,6 +204,8 @@ class StageBinding {
             own_ = std::make_unique<StageSession>();
             session_ = own_.get();
         }
+        up0_ = session_->uploaded_bytes();
+        down0_ = session_->downloaded_bytes();
         CollectStageTables collect{&refs_};
         stage_.VisitTables(collect);
         session_->Acquire(name, refs_, &device_);
@@ -210,6 +217,9 @@ class StageBinding {
         session_->Produced(refs_);
         if (own_) session_->DownloadOutputs(refs_);
     }
+    // Bytes this run copied (uploads in the constructor, downloads in Finish).
+    int64_t bytes_up() const { return session_->uploaded_bytes() - up0_; }
+    int64_t bytes_down() const { return session_->downloaded_bytes() - down0_; }
 
   private:
     Stage stage_;
@@ -217,6 +227,7 @@ class StageBinding {
     std::vector<float*> device_;
     StageSession* session_ = nullptr;
     std::unique_ptr<StageSession> own_;
+    int64_t up0_ = 0, down0_ = 0;
 };
 
 #if defined(ATMOS_HAS_CUDA)
@@ -246,11 +257,14 @@ void RunStage(const char* name, int64_t count, int64_t grain, const Stage& stage
 #endif
     }
     const auto start = std::chrono::steady_clock::now();
+    int64_t up = 0, down = 0;
     if (backend == Backend::kEmulatedDevice) {
         StageBinding<Stage> binding(name, stage);
         const Stage& copy = binding.stage();
         ParallelFor(count, grain, [&](int64_t i) { copy(i); });
         binding.Finish();
+        up = binding.bytes_up();
+        down = binding.bytes_down();
     } else {
         ParallelFor(count, grain, [&](int64_t i) { stage(i); });
     }
@@ -258,7 +272,7 @@ void RunStage(const char* name, int64_t count, int64_t grain, const Stage& stage
         const double ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
-        LogStage({name, count, BackendName(backend), ms, ms});
+        LogStage({name, count, BackendName(backend), ms, ms, up, down});
     }
 }
 
