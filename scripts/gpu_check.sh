@@ -46,7 +46,7 @@ run() {  # run NAME COMMAND...: logs to $OUT/NAME.log, records the exit status
     tail -n 25 "$OUT/$name.log"
     [ $rc -eq 0 ] || status=1
 }
-device_tests='CudaParity*:CudaPrecompute*:Backend*:Stages*'
+device_tests='Cuda*:Backend*:Stages*:EmulatedDevice*'
 models_arg=()
 [ -n "${MODELS:-}" ] && models_arg=(--models "$MODELS")
 
