@@ -23,20 +23,13 @@
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "cuda/runtime.h"
+#include "cuda_test_util.h"
 #include "metrics/flip.h"
 #include "models/bruneton.h"
 #include "render/stages.h"
 
 namespace atmos {
 namespace {
-
-#define ATMOS_SKIP_WITHOUT_DEVICE()                                                  \
-    do {                                                                             \
-        std::string status;                                                          \
-        if (cuda::DeviceCount(&status) <= 0) {                                       \
-            GTEST_SKIP() << "no CUDA device (cudaGetDeviceCount: " << status << ")"; \
-        }                                                                            \
-    } while (0)
 
 constexpr double kMaxRelative = 1e-4;
 constexpr double kMaxMeanFlip = 1e-3;

@@ -25,6 +25,7 @@
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "cuda/runtime.h"
+#include "cuda_test_util.h"
 #include "metrics/flip.h"
 #include "models/atmosphere_plus.h"
 #include "models/hillaire.h"
@@ -37,14 +38,6 @@ constexpr double kMaxRelativeError = 1e-4;
 constexpr double kFloorOfMax = 1e-6;
 constexpr double kOutlierFraction = 1.0 / 1000.0;
 constexpr double kMaxMeanFlip = 1e-3;
-
-#define ATMOS_SKIP_WITHOUT_DEVICE()                                                  \
-    do {                                                                             \
-        std::string status;                                                          \
-        if (cuda::DeviceCount(&status) <= 0) {                                       \
-            GTEST_SKIP() << "no CUDA device (cudaGetDeviceCount: " << status << ")"; \
-        }                                                                            \
-    } while (0)
 
 void ExpectTablesAgree(const Table& cpu, const Table& gpu, const char* what) {
     SCOPED_TRACE(what);

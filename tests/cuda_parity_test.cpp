@@ -26,6 +26,7 @@
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "cuda/runtime.h"
+#include "cuda_test_util.h"
 #include "metrics/flip.h"
 
 namespace atmos {
@@ -34,14 +35,6 @@ namespace {
 constexpr double kMaxRelativeError = 1e-3;
 constexpr double kOutlierFraction = 1.0 / 500.0;
 constexpr double kMaxMeanFlip = 1e-3;
-
-#define ATMOS_SKIP_WITHOUT_DEVICE()                                                  \
-    do {                                                                             \
-        std::string status;                                                          \
-        if (cuda::DeviceCount(&status) <= 0) {                                       \
-            GTEST_SKIP() << "no CUDA device (cudaGetDeviceCount: " << status << ")"; \
-        }                                                                            \
-    } while (0)
 
 Image RenderOn(Backend backend, const Model& model, const RenderRequest& request) {
     const BackendScope scope(backend);
