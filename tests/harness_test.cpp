@@ -250,5 +250,39 @@ TEST(Cli, CompareWritesTablesImagesAndUsesTheCache) {
     EXPECT_EQ(spp.status, 2);
 }
 
+// Variants of one model side by side: NAME:OPTION=VALUE specs. More view-ray
+// steps bring naive closer to a 256-step naive reference.
+TEST(Cli, CompareTakesModelVariants) {
+    const fs::path dir = TempDir("compare-variants");
+    const std::string out = (dir / "out").string();
+    CliRun r = Atmos(
+        "compare --models naive:steps=2,naive:steps=64:light-steps=16 --views ground-sunrise "
+        "--size 24x14 --reference naive --reference-option steps=256 --reference-option "
+        "light-steps=64 --no-cache -o " +
+            out,
+        dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::istringstream flip(Slurp(dir / "out" / "flip.csv"));
+    std::string header, row;
+    std::getline(flip, header);
+    std::getline(flip, row);
+    EXPECT_EQ(header, "FLIP errors,naive:steps=2,naive:steps=64:light-steps=16,best");
+    std::istringstream cells(row);
+    std::string view, coarse, fine, best;
+    std::getline(cells, view, ',');
+    std::getline(cells, coarse, ',');
+    std::getline(cells, fine, ',');
+    std::getline(cells, best, ',');
+    EXPECT_LT(std::stod(fine), std::stod(coarse));
+    EXPECT_EQ(best, "naive:steps=64:light-steps=16");
+    EXPECT_TRUE(fs::exists(dir / "out" / "images" / "ground-sunrise" / "naive_steps_2.png"));
+    for (const char* bad :
+         {"naive:steps", "naive:nope=3", "naive:steps=0", "naive:steps=2:steps=3", "naive,naive"}) {
+        CliRun b = Atmos(std::string("compare --models ") + bad + " -o " + out, dir);
+        EXPECT_EQ(b.status, 2) << bad;
+        EXPECT_NE(b.err.find("error"), std::string::npos) << bad << ": " << b.err;
+    }
+}
+
 }  // namespace
 }  // namespace atmos

@@ -63,7 +63,7 @@ int CmdCompare(const CompareCliOptions& o) {
     config.models = o.models;
     config.views = o.views;
     for (const std::string& v : o.views) GetView(v, AtmosphereParameters{});  // fail early
-    for (const std::string& m : o.models) GetModelInfo(m);
+    for (const std::string& m : o.models) ParseModelSpec(m);                  // fail early
     config.atmosphere_name = o.atmosphere;
     config.atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
     config.output_dir = !o.output.empty()                             ? o.output
@@ -130,7 +130,9 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
     o->command_line = cl.str();
     CLI::App* cmd = root->add_subcommand(
         "compare", "every model against the reference: FLIP, RMSE, images, index.html");
-    cmd->add_option("--models", o->models, "models (default: all but the reference)")
+    cmd->add_option("--models", o->models,
+                    "models (default: all but the reference); NAME:OPTION=VALUE[:...] compares a "
+                    "model with options, e.g. hillaire:segment-offset=0.5")
         ->delimiter(',');
     cmd->add_option("--views", o->views, "views (default: all 12; transmittance: 5)")
         ->delimiter(',');

@@ -1,6 +1,7 @@
 // atmos: the comparison harness (see compare.h).
 #include "harness/compare.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -168,32 +169,68 @@ void WriteMetricCsv(const std::string& path, const std::string& corner,
     if (!f) Fail("cannot write '", path, "'");
 }
 
+ModelSpec ParseModelSpec(const std::string& text) {
+    ModelSpec spec;
+    spec.text = text;
+    size_t at = text.find(':');
+    spec.name = text.substr(0, at);
+    const ModelInfo& info = GetModelInfo(spec.name);
+    while (at != std::string::npos) {
+        const size_t next = text.find(':', at + 1);
+        const std::string item =
+            text.substr(at + 1, next == std::string::npos ? next : next - at - 1);
+        const size_t eq = item.find('=');
+        if (eq == std::string::npos || eq == 0) {
+            Fail("model '", text, "': expected NAME:OPTION=VALUE[:OPTION=VALUE...], got '", item,
+                 "'");
+        }
+        if (!spec.options.emplace(item.substr(0, eq), item.substr(eq + 1)).second) {
+            Fail("model '", text, "': option '", item.substr(0, eq), "' given twice");
+        }
+        at = next;
+    }
+    ModelOptions(info.name, info.options, spec.options);  // validates names and values
+    return spec;
+}
+
 CompareResult RunCompare(const CompareConfig& config) {
     const auto start = std::chrono::steady_clock::now();
     CompareResult result;
     result.threads = ParallelThreadCount();
     const bool transmittance = config.quantity == Quantity::kTransmittance;
 
-    // Models: those given, or every registered one producing the quantity.
+    // Models: those given (with their options), or every registered one
+    // producing the quantity.
+    std::vector<ModelSpec> specs;
     if (config.models.empty()) {
         for (const ModelInfo& info : ListModels()) {
             if (info.name == "reference") continue;
             if (transmittance ? !info.capabilities.transmittance : !info.capabilities.radiance) {
                 continue;
             }
-            result.models.push_back(info.name);
+            specs.push_back(ParseModelSpec(info.name));
         }
     } else {
         for (const std::string& m : config.models) {
-            const ModelInfo& info = GetModelInfo(m);
+            const ModelSpec spec = ParseModelSpec(m);
+            const ModelInfo& info = GetModelInfo(spec.name);
             if (transmittance ? !info.capabilities.transmittance : !info.capabilities.radiance) {
                 Fail("model '", m, "' does not produce ", QuantityName(config.quantity));
             }
-            result.models.push_back(info.name);
+            for (const ModelSpec& other : specs) {
+                if (other.text == spec.text) Fail("compare: model '", m, "' given twice");
+            }
+            specs.push_back(spec);
         }
     }
-    if (result.models.empty()) Fail("compare: no model to compare");
-    for (const std::string& m : result.models) result.model_titles.push_back(GetModelInfo(m).title);
+    if (specs.empty()) Fail("compare: no model to compare");
+    for (const ModelSpec& spec : specs) {
+        result.models.push_back(spec.text);
+        result.model_names.push_back(spec.name);
+        std::string title = GetModelInfo(spec.name).title;
+        for (const auto& [option, value] : spec.options) title += ", --" + option + " " + value;
+        result.model_titles.push_back(title);
+    }
     const std::vector<std::string> view_names =
         config.views.empty() ? DefaultCompareViews(config.quantity) : config.views;
     std::vector<View> views;
@@ -204,9 +241,8 @@ CompareResult RunCompare(const CompareConfig& config) {
     const RenderCache cache(config.cache_dir);
     LazyRenderer reference(config.reference_model, config.reference_options, config, cache);
     std::vector<std::unique_ptr<LazyRenderer>> renderers;
-    for (const std::string& m : result.models) {
-        renderers.push_back(
-            std::make_unique<LazyRenderer>(m, std::map<std::string, std::string>{}, config, cache));
+    for (const ModelSpec& spec : specs) {
+        renderers.push_back(std::make_unique<LazyRenderer>(spec.name, spec.options, config, cache));
     }
 
     for (const View& view : views) {
@@ -243,8 +279,8 @@ CompareResult RunCompare(const CompareConfig& config) {
             const Image abs_error = AbsoluteErrorImage(ref, img);
             WriteImage(abs_error, (error_dir / (stem + "-rmse.exr")).string());
             WriteImage(abs_error, (error_dir / (stem + "-rmse.png")).string(), exposure);
-            cell.validity_note =
-                ValidityNote(GetModelInfo(name).capabilities, view, config.atmosphere);
+            cell.validity_note = ValidityNote(GetModelInfo(result.model_names[m]).capabilities,
+                                              view, config.atmosphere);
             cell.image_png = (fs::path("images") / FileStem(view.name) / (stem + ".png")).string();
             cell.flip_png =
                 (fs::path("errors") / FileStem(view.name) / (stem + "-flip.png")).string();
@@ -266,7 +302,14 @@ CompareResult RunCompare(const CompareConfig& config) {
     }
     result.reference_prepare_seconds = reference.prepare_seconds();
     const std::string source_dir = DefaultSourceDir();
-    for (const std::string& m : result.models) result.loc.push_back(CountModelLoc(source_dir, m));
+    for (size_t m = 0; m < result.model_names.size(); ++m) {
+        // Once per registered model (variants share their model's code).
+        const auto first =
+            std::find(result.model_names.begin(), result.model_names.end(), result.model_names[m]);
+        if (first - result.model_names.begin() == static_cast<std::ptrdiff_t>(m)) {
+            result.loc.push_back(CountModelLoc(source_dir, result.model_names[m]));
+        }
+    }
     result.loc.push_back(CountModelLoc(source_dir, config.reference_model));
 
     // Tables (thesis Appendix A/B, or C/D for transmittance) and times.

@@ -64,13 +64,14 @@ struct CompareRow {
 };
 
 struct CompareResult {
-    std::vector<std::string> models;
+    std::vector<std::string> models;       // the specs as given (column names)
+    std::vector<std::string> model_names;  // their registered models
     std::vector<std::string> model_titles;
     std::vector<double> prepare_seconds;  // per model; 0 when every image came from the cache
     std::vector<bool> prepared;
     double reference_prepare_seconds = 0.0;
     std::vector<CompareRow> rows;
-    std::vector<ModelLoc> loc;  // per model, plus the reference model last
+    std::vector<ModelLoc> loc;  // per registered model (once), plus the reference model last
     double total_seconds = 0.0;
     int threads = 0;
 };
@@ -83,6 +84,19 @@ std::string CompareRowLabel(const std::string& view, Quantity quantity);
 // Why `view` lies outside the model's declared validity, or "" if it does not.
 std::string ValidityNote(const ModelCapabilities& caps, const View& view,
                          const AtmosphereParameters& atmosphere);
+
+// A model to compare: a registered name, optionally with options after colons,
+// `NAME[:OPTION=VALUE]...` (e.g. `hillaire:segment-offset=0.5`), so that
+// variants of one model are compared side by side. The spec text names the
+// model's column and files.
+struct ModelSpec {
+    std::string text;
+    std::string name;
+    std::map<std::string, std::string> options;
+};
+// Parses and validates a spec (unknown model, unknown option, bad value: one
+// atmos::Error).
+ModelSpec ParseModelSpec(const std::string& text);
 
 // Runs the comparison and writes images, error maps, flip.csv, rmse.csv,
 // times.csv and index.html into config.output_dir. Throws atmos::Error.
