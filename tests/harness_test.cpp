@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -248,6 +249,50 @@ TEST(Cli, CompareWritesTablesImagesAndUsesTheCache) {
     CliRun spp =
         Atmos("compare --reference naive --reference-spp 4 -o " + (dir / "x").string(), dir);
     EXPECT_EQ(spp.status, 2);
+}
+
+// A path-traced reference is two independent halves, averaged; their HDR-FLIP
+// is the reference's noise, reported per view, and FLIPs at or below it are
+// marked as unresolved.
+TEST(Cli, CompareMeasuresTheReferencesNoise) {
+    const fs::path dir = TempDir("compare-noise");
+    const std::string args =
+        "compare --models empty,naive --views space,ground-noon --size 32x18 --reference-spp 4 "
+        "--cache " +
+        (dir / "cache").string() + " -o " + (dir / "out").string();
+    CliRun r = Atmos(args, dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string noise_csv = Slurp(dir / "out" / "reference_noise.csv");
+    std::istringstream noise(noise_csv);
+    std::string line;
+    std::getline(noise, line);
+    EXPECT_EQ(line, "view,reference_noise_flip,half_spp");
+    std::map<std::string, double> floor;
+    while (std::getline(noise, line)) {
+        const size_t a = line.find(','), b = line.rfind(',');
+        floor[line.substr(0, a)] = std::stod(line.substr(a + 1, b - a - 1));
+        EXPECT_EQ(line.substr(b + 1), "2");  // two halves of 2 spp
+    }
+    ASSERT_EQ(floor.size(), 2u);
+    for (const auto& [view, flip] : floor) {
+        EXPECT_GT(flip, 0.0) << view;  // different seeds differ
+        EXPECT_LT(flip, 1.0) << view;
+    }
+    // The white `empty` sky is far above the reference's noise.
+    std::istringstream flips(Slurp(dir / "out" / "flip.csv"));
+    std::getline(flips, line);
+    EXPECT_EQ(line, "FLIP errors,empty,naive,best");
+    while (std::getline(flips, line)) {
+        const std::string view = line.substr(0, line.find(','));
+        const double empty = std::stod(line.substr(line.find(',') + 1));
+        EXPECT_GT(empty, floor.at(view)) << view;
+    }
+    EXPECT_NE(Slurp(dir / "out" / "index.html").find("reference noise</th>"), std::string::npos);
+    // Both halves come from the cache on a second run: the same noise.
+    CliRun again = Atmos(args, dir);
+    ASSERT_EQ(again.status, 0) << again.err;
+    EXPECT_NE(again.err.find("reference (reference) cached"), std::string::npos) << again.err;
+    EXPECT_EQ(Slurp(dir / "out" / "reference_noise.csv"), noise_csv);
 }
 
 // Variants of one model side by side: NAME:OPTION=VALUE specs. More view-ray

@@ -239,7 +239,30 @@ CompareResult RunCompare(const CompareConfig& config) {
     const fs::path out(config.output_dir);
     fs::create_directories(out);
     const RenderCache cache(config.cache_dir);
-    LazyRenderer reference(config.reference_model, config.reference_options, config, cache);
+    // A Monte Carlo reference: two independent halves, averaged (the same
+    // number of paths), whose difference measures its noise.
+    const ModelInfo& reference_info = GetModelInfo(config.reference_model);
+    const std::map<std::string, std::string> reference_resolved =
+        ResolvedModelOptions(config.reference_model, config.reference_options);
+    const bool split_reference = !transmittance && reference_info.capabilities.stochastic &&
+                                 reference_resolved.count("spp") &&
+                                 reference_resolved.count("seed") &&
+                                 std::stoll(reference_resolved.at("spp")) >= 2;
+    std::map<std::string, std::string> half_a = config.reference_options;
+    std::map<std::string, std::string> half_b = config.reference_options;
+    int64_t spp_a = 0, spp_b = 0;
+    if (split_reference) {
+        const int64_t spp = std::stoll(reference_resolved.at("spp"));
+        const int64_t seed = std::stoll(reference_resolved.at("seed"));
+        spp_a = spp / 2;
+        spp_b = spp - spp_a;
+        half_a["spp"] = std::to_string(spp_a);
+        half_b["spp"] = std::to_string(spp_b);
+        half_a["seed"] = std::to_string(2 * seed + 1);
+        half_b["seed"] = std::to_string(2 * seed + 2);
+    }
+    LazyRenderer reference(config.reference_model, half_a, config, cache);
+    LazyRenderer reference_b(config.reference_model, half_b, config, cache);
     std::vector<std::unique_ptr<LazyRenderer>> renderers;
     for (const ModelSpec& spec : specs) {
         renderers.push_back(std::make_unique<LazyRenderer>(spec.name, spec.options, config, cache));
@@ -255,7 +278,19 @@ CompareResult RunCompare(const CompareConfig& config) {
         const fs::path error_dir = out / "errors" / FileStem(view.name);
         fs::create_directories(image_dir);
         fs::create_directories(error_dir);
-        const Image ref = reference.Render(view, &row.reference_seconds, &row.reference_cached);
+        Image ref = reference.Render(view, &row.reference_seconds, &row.reference_cached);
+        if (split_reference) {
+            double seconds_b = 0.0;
+            bool cached_b = false;
+            const Image b = reference_b.Render(view, &seconds_b, &cached_b);
+            row.reference_noise = HdrFlip(ref, b, config.flip).mean;
+            const float wa = static_cast<float>(spp_a) / static_cast<float>(spp_a + spp_b);
+            for (size_t i = 0; i < ref.size(); ++i) {
+                ref.data()[i] = wa * ref.data()[i] + (1.0f - wa) * b.data()[i];
+            }
+            row.reference_seconds += seconds_b;
+            row.reference_cached = row.reference_cached && cached_b;
+        }
         WriteImages(ref, image_dir, "reference", exposure, config.write_npy);
         row.reference_png = (fs::path("images") / FileStem(view.name) / "reference.png").string();
         if (config.show_progress) {
@@ -274,6 +309,7 @@ CompareResult RunCompare(const CompareConfig& config) {
             const RmseResult rmse = ComputeRmse(ref, img);
             cell.flip = flip.mean;
             cell.rmse = rmse.overall;
+            cell.within_noise = row.reference_noise >= 0.0 && cell.flip <= row.reference_noise;
             WriteColorMappedPng(flip.map, flip.width, flip.height,
                                 (error_dir / (stem + "-flip.png")).string());
             const Image abs_error = AbsoluteErrorImage(ref, img);
@@ -300,7 +336,7 @@ CompareResult RunCompare(const CompareConfig& config) {
         result.prepare_seconds.push_back(r->prepare_seconds());
         result.prepared.push_back(r->prepared());
     }
-    result.reference_prepare_seconds = reference.prepare_seconds();
+    result.reference_prepare_seconds = reference.prepare_seconds() + reference_b.prepare_seconds();
     const std::string source_dir = DefaultSourceDir();
     for (size_t m = 0; m < result.model_names.size(); ++m) {
         // Once per registered model (variants share their model's code).
@@ -327,6 +363,13 @@ CompareResult RunCompare(const CompareConfig& config) {
     }
     WriteMetricCsv((out / "flip.csv").string(), "FLIP errors", labels, result.models, flips);
     WriteMetricCsv((out / "rmse.csv").string(), "RMSE errors", labels, result.models, rmses);
+    if (split_reference) {
+        std::ofstream f(out / "reference_noise.csv");
+        f << "view,reference_noise_flip,half_spp\n";
+        for (const CompareRow& row : result.rows) {
+            f << row.view << "," << row.reference_noise << "," << spp_a << "\n";
+        }
+    }
     {
         std::ofstream f(out / "times.csv");
         f << "view,model,render_seconds,cached,prepare_seconds\n";

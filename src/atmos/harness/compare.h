@@ -48,7 +48,10 @@ struct CompareCell {
     double render_seconds = 0.0;
     bool cached = false;
     std::string validity_note;  // non-empty: the view is outside the model's declared validity
-    std::string image_png;      // paths relative to the output directory
+    // FLIP at or below the row's reference_noise: the difference to the
+    // reference is not resolved by it.
+    bool within_noise = false;
+    std::string image_png;  // paths relative to the output directory
     std::string flip_png;
     std::string rmse_png;
 };
@@ -60,6 +63,11 @@ struct CompareRow {
     std::string reference_png;
     double reference_seconds = 0.0;
     bool reference_cached = false;
+    // A Monte Carlo reference is rendered as two independent halves (spp/2
+    // each, seeds 2s+1 and 2s+2) and averaged; this is the HDR-FLIP between the
+    // halves: the reference's own noise, an upper bound for its error at the full
+    // spp. Negative when not measured (deterministic reference, transmittance).
+    double reference_noise = -1.0;
     std::vector<CompareCell> cells;  // one per model, in CompareResult::models order
 };
 

@@ -39,6 +39,11 @@ void MetricTable(std::ostream& f, const std::string& title, int digits, const Co
         f << "<th title=\"" << HtmlEscape(r.model_titles[m]) << "\">" << HtmlEscape(r.models[m])
           << "</th>";
     }
+    const bool noise = flip && !r.rows.empty() && r.rows.front().reference_noise >= 0.0;
+    if (noise) {
+        f << "<th title=\"HDR-FLIP between the reference's two independent halves\">reference "
+             "noise</th>";
+    }
     f << "</tr>\n";
     for (const CompareRow& row : r.rows) {
         std::vector<double> values;
@@ -48,11 +53,22 @@ void MetricTable(std::ostream& f, const std::string& title, int digits, const Co
         for (size_t m = 0; m < row.cells.size(); ++m) {
             const CompareCell& c = row.cells[m];
             const bool is_best = static_cast<int>(m) == best;
-            f << "<td" << (is_best ? " class=\"best\"" : "");
-            if (!c.validity_note.empty()) f << " title=\"" << HtmlEscape(c.validity_note) << "\"";
+            const bool unresolved = flip && c.within_noise;
+            std::string tip = c.validity_note;
+            if (unresolved) {
+                tip += std::string(tip.empty() ? "" : "; ") +
+                       "at or below the reference's own noise: not resolved";
+            }
+            f << "<td";
+            if (is_best || unresolved) {
+                f << " class=\"" << (is_best ? "best" : "") << (is_best && unresolved ? " " : "")
+                  << (unresolved ? "noise" : "") << "\"";
+            }
+            if (!tip.empty()) f << " title=\"" << HtmlEscape(tip) << "\"";
             f << ">" << Fixed(values[m], digits) << (c.validity_note.empty() ? "" : " &dagger;")
-              << "</td>";
+              << (unresolved ? " &asymp;" : "") << "</td>";
         }
+        if (noise) f << "<td class=\"noise\">" << Fixed(row.reference_noise, digits) << "</td>";
         f << "</tr>\n";
     }
     f << "</table>\n";
@@ -130,6 +146,7 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
          "3px 7px;font-size:13px}th{background:#222;font-weight:normal}\n"
       << "td{text-align:right;font-family:monospace}caption{text-align:left;padding:4px 0}\n"
       << "td.best{background:#274;color:#fff;font-weight:bold}\n"
+      << "td.noise{font-style:italic;color:#888}\ntd.best.noise{color:#cdc}\n"
       << ".row{display:flex;gap:10px;overflow-x:auto;padding-bottom:8px}\n"
       << "figure{margin:0;flex:0 0 auto;width:240px}figure img{width:240px;display:block;"
          "background:#000;margin-bottom:2px}\n"
@@ -172,7 +189,15 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
 
     f << "<h2>Errors against the reference</h2>\n<p>Lowest value per row highlighted. "
          "&dagger;: the view lies outside the model's declared validity (rendered anyway). "
-         "Also in <a href=\"flip.csv\">flip.csv</a> and <a href=\"rmse.csv\">rmse.csv</a>.</p>\n";
+         "Also in <a href=\"flip.csv\">flip.csv</a> and <a href=\"rmse.csv\">rmse.csv</a>.";
+    if (!r.rows.empty() && r.rows.front().reference_noise >= 0.0) {
+        f << " The path-traced reference is the average of two independent halves; <i>reference "
+             "noise</i> is the HDR-FLIP between them (<a href=\"reference_noise.csv\">"
+             "reference_noise.csv</a>), an upper bound of the reference's own error. A FLIP at or "
+             "below it (&asymp;, grey) is not resolved by this reference: raise "
+             "<code>--reference-spp</code> to rank those models.";
+    }
+    f << "</p>\n";
     MetricTable(f,
                 transmittance ? "FLIP errors, transmittance (LDR-FLIP)" : "FLIP errors (HDR-FLIP)",
                 6, r, true);
