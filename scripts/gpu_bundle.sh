@@ -12,14 +12,21 @@ scripts/setup.sh build-gpu >/dev/null 2>&1 || true  # installs the packages
 cmake -S . -B build-gpu -G Ninja -DCMAKE_BUILD_TYPE=Release -DATMOS_CUDA=ON \
       -DATMOS_CUDA_ARCHITECTURES="$arch" >/dev/null
 cmake --build build-gpu -j "$(nproc)"
-rm -rf .gpu && mkdir -p .gpu/lib
+rm -rf .gpu && mkdir -p .gpu/lib .gpu/lib-fallback
 cp build-gpu/atmos build-gpu/tests/atmos_tests build-gpu/bench/atmos_bench .gpu/
 strip .gpu/atmos .gpu/atmos_tests .gpu/atmos_bench
-# Every shared library but the C runtime's own (present on any Linux).
+# Every shared library but the C runtime's own (present on any Linux). The C++
+# runtime goes to lib-fallback: gpu_check.sh uses it only if the machine's own
+# is too old, so that tools like compute-sanitizer keep their newer one.
 for bin in .gpu/atmos .gpu/atmos_tests .gpu/atmos_bench; do
     ldd "$bin" | awk '/=> \//{print $3}'
 done | sort -u | grep -v -E '/(libc|libm|libpthread|libdl|librt|ld-linux[^/]*)\.so' |
-    while read -r lib; do cp -L "$lib" .gpu/lib/; done
+    while read -r lib; do
+        case "$(basename "$lib")" in
+            libstdc++*|libgcc_s*) cp -L "$lib" .gpu/lib-fallback/ ;;
+            *) cp -L "$lib" .gpu/lib/ ;;
+        esac
+    done
 git rev-parse HEAD > .gpu/commit
 du -sh .gpu
 echo "bundle for sm_$arch at $(cat .gpu/commit): .gpu/ (run scripts/gpu_check.sh on the GPU machine)"

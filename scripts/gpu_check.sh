@@ -31,6 +31,14 @@ if [ ! -x "$B/atmos" ]; then
     exit 2
 fi
 export LD_LIBRARY_PATH="$PWD/$B/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+if ! "$B/atmos" list >/dev/null 2>&1; then  # the machine's C++ runtime is too old
+    export LD_LIBRARY_PATH="$LD_LIBRARY_PATH:$PWD/$B/lib-fallback"
+fi
+if ! "$B/atmos" list >/dev/null 2>&1; then
+    echo "gpu_check: the bundle does not run here:" >&2
+    "$B/atmos" list 2>&1 | head -5 >&2
+    exit 2
+fi
 export ATMOS_SOURCE_DIR="$PWD"
 SIZE="${SIZE:-1920x1080}"
 REPEAT="${REPEAT:-256}"
