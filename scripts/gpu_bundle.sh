@@ -27,6 +27,6 @@ done | sort -u | grep -v -E '/(libc|libm|libpthread|libdl|librt|ld-linux[^/]*)\.
             *) cp -L "$lib" .gpu/lib/ ;;
         esac
     done
-git rev-parse HEAD > .gpu/commit
+git describe --always --dirty --abbrev=40 > .gpu/commit
 du -sh .gpu
 echo "bundle for sm_$arch at $(cat .gpu/commit): .gpu/ (run scripts/gpu_check.sh on the GPU machine)"
