@@ -21,6 +21,7 @@ void RunReference(benchmark::State& state, const char* view_name, bool spectral,
     e.shells = BuildMajorantShells(atm, shells);
     e.spectral = spectral;
     e.sample_count = 1;
+    e.need_transmittance = false;  // as in a radiance render (no sun disc): the paths alone
     const int w = 48, h = 27;
     int64_t i = 0;
     for (auto _ : state) {

@@ -252,6 +252,7 @@ void ReferenceModel::Render(const RenderRequest& request, Image* out) const {
         ReferenceEvaluator e = evaluator_;
         e.sample_begin = p * pass_spp;
         e.sample_count = std::min(pass_spp, spp_ - e.sample_begin);
+        e.need_transmittance = request.sun_disc;  // the only use of T in a radiance pass
         RenderImage(e, setup, pass.View(), &progress);
         // Weighted by the pass's sample count so a short last pass counts right.
         const float wgt = static_cast<float>(e.sample_count);

@@ -96,6 +96,10 @@ struct ReferenceEvaluator {
     uint64_t seed = 0;
     int sample_begin = 0;  // the samples [sample_begin, sample_begin + sample_count)
     int sample_count = 1;
+    // Whether the view ray's transmittance (1024-interval integral, ~20-40 us
+    // per pixel on the CPU) is computed: only the sun's disc, the transmittance
+    // output and `sample` use it; a radiance pass without the disc leaves it 1.
+    bool need_transmittance = true;
     int max_order = 0;  // 0: unlimited (Russian roulette)
     // false: the thesis's estimator (seed 003 section 4: one random channel per
     // path, plain delta tracking against the shells' majorant, delta tracking
@@ -431,7 +435,10 @@ struct ReferenceEvaluator {
         AtmosphereSegment seg;
         if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) return out;
         const Vec3d start = camera + dir * seg.t_start;
-        out.transmittance = Rgb(Exp(-OpticalDepth(atm, start, dir, seg.t_end - seg.t_start, 1024)));
+        if (need_transmittance) {
+            out.transmittance =
+                Rgb(Exp(-OpticalDepth(atm, start, dir, seg.t_end - seg.t_start, 1024)));
+        }
         const int shell = seg.t_start > 0.0 ? shells.count - 1 : shells.ShellOf(Length(start));
         // Forced first collision unless the segment ends on a reflecting ground.
         const bool reflective_end = seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0;
