@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <vector>
 
 #include "atmos/atmosphere.h"
@@ -391,6 +392,66 @@ TEST(Reference, FiniteNonNegativeInEveryView) {
         for (size_t i = 0; i < image.size(); ++i) {
             ASSERT_TRUE(std::isfinite(image.data()[i]) && image.data()[i] >= 0.0f) << view.name;
         }
+    }
+}
+
+}  // namespace
+}  // namespace atmos
+
+namespace atmos {
+namespace {
+
+// The view ray's transmittance is computed only where it is used: a radiance
+// pass without the sun's disc skips it (same sky), a render with the disc adds
+// irradiance x T x 1/(pi alpha^2) inside it, with T the transmittance render's.
+TEST(Reference, TransmittanceOnlyWhereUsedAndTheSunDiscUsesIt) {
+    const AtmosphereParameters atm = EarthAtmosphere();
+    View view = GetView("ground-sunrise", atm);
+    // A camera looking at the sun through a 0.1 degree field: every pixel in its disc.
+    view.camera =
+        MakeCamera(view.camera.position, view.sun_direction, Normalize(view.camera.position), 0.1);
+    std::unique_ptr<Model> model = CreateModel("reference", {{"spp", "4"}});
+    model->Prepare(atm);
+    RenderRequest r;
+    r.view = view;
+    r.width = 4;
+    r.height = 4;
+    r.show_progress = false;
+    Image without, with, transmittance;
+    model->Render(r, &without);
+    r.sun_disc = true;
+    model->Render(r, &with);
+    r.sun_disc = false;
+    r.quantity = Quantity::kTransmittance;
+    model->Render(r, &transmittance);
+    const double alpha = atm.sun_angular_radius;
+    const Vec3d irradiance = atm.solar_irradiance * view.sun_irradiance;
+    for (int y = 0; y < 4; ++y) {
+        for (int x = 0; x < 4; ++x) {
+            const Rgb t = transmittance.Get(x, y);
+            const Rgb d = with.Get(x, y) - without.Get(x, y);
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_GT(t[c], 0.0f);
+                EXPECT_LT(t[c], 1.0f);  // a real transmittance, not the skipped 1
+                const double expected =
+                    irradiance[c] * static_cast<double>(t[c]) / (kPi * alpha * alpha);
+                EXPECT_NEAR(static_cast<double>(d[c]), expected, 1e-4 * expected)
+                    << x << "," << y << " ch " << c;
+            }
+        }
+    }
+    // The evaluator: the same paths with or without T; T = 1 when skipped.
+    ReferenceEvaluator e = static_cast<const ReferenceModel&>(*model).evaluator();
+    e.sample_count = 2;
+    const Vec3d dir = view.camera.RayDirection(1, 1, 4, 4);
+    e.need_transmittance = true;
+    const RayResult a = e.EvaluateKeyed(view.camera.position, dir, view.sun_direction, true, 7);
+    e.need_transmittance = false;
+    const RayResult b = e.EvaluateKeyed(view.camera.position, dir, view.sun_direction, true, 7);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(a.sky[c], b.sky[c]);
+        EXPECT_LT(a.transmittance[c], 1.0f);
+        EXPECT_EQ(b.transmittance[c], 1.0f);
     }
 }
 
