@@ -172,6 +172,24 @@ TEST(EmulatedDevice, HillaireTablesAndFrameMatchTheCpu) {
     EXPECT_TRUE(SameBits(a->sky_view, b->sky_view));
     EXPECT_TRUE(SameBits(a->ap_scatter, b->ap_scatter));
     EXPECT_TRUE(SameBits(a->ap_transmittance, b->ap_transmittance));
+    // `sample` through one sky-view table per (altitude, sun) group, in one session.
+    std::vector<SampleQuery> queries;
+    for (double alt : {0.0, 3e3, 30e3}) {
+        for (double mu : {-0.2, 0.05, 0.7}) queries.push_back({alt, mu, 0.3, 40.0});
+    }
+    const std::vector<SampleAnswer> sa = cpu.Sample(queries);
+    std::vector<SampleAnswer> sb;
+    {
+        const BackendScope scope(Backend::kEmulatedDevice);
+        sb = dev.Sample(queries);
+    }
+    ASSERT_EQ(sa.size(), sb.size());
+    for (size_t i = 0; i < sa.size(); ++i) {
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(sa[i].radiance[c], sb[i].radiance[c]) << i;
+            EXPECT_EQ(sa[i].transmittance[c], sb[i].transmittance[c]) << i;
+        }
+    }
 }
 
 TEST(EmulatedDevice, AtmospherePlusTablesMatchTheCpu) {

@@ -254,12 +254,17 @@ std::vector<SampleAnswer> HillaireModel::Sample(const std::vector<SampleQuery>& 
         groups[{queries[q].altitude_m, queries[q].mu_s}].push_back(q);
     }
     std::vector<SampleAnswer> answers(queries.size());
+    // On a device backend the model's tables are uploaded once for all groups;
+    // each group's sky-view table is resized in place (its old device copy is
+    // dropped) and downloaded for the host's queries.
+    StageSession session;
+    Table sky_view;
     for (const auto& group : groups) {
         const double r = atm.bottom_radius + group.first.first;
         HillaireEvaluator e = evaluator_;
-        Table sky_view;
         if (r <= atm.top_radius) {
             BuildSkyView(r, ClampCosine(group.first.second), &sky_view);
+            session.Download(&sky_view);
             e.sky_view = sky_view.view();
         }
         const std::vector<size_t>& members = group.second;
