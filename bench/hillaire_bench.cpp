@@ -30,7 +30,7 @@ constexpr int kWidth = 1920;
 constexpr int kHeight = 1080;
 
 std::unique_ptr<HillaireModel> PreparedModel() {
-    const ModelOptions options("hillaire", HillaireModel::StaticInfo().options, {});
+    const HillaireOptions options;
     auto model = std::make_unique<HillaireModel>(options);
     model->Prepare(EarthAtmosphere());
     return model;

@@ -686,8 +686,8 @@ TEST(Bruneton, CliBakeThenRenderFromTheBake) {
     fs::create_directories(dir);
     const std::string cli = ATMOS_CLI_PATH;
     const std::string opts =
-        " --model bruneton --scattering-r 4 --scattering-mu 16 --scattering-mu-s 8 "
-        "--scattering-nu 4 --orders 2 -q";
+        " --model bruneton:scattering-r=4:scattering-mu=16:scattering-mu-s=8:scattering-nu=4:"
+        "orders=2 -q";
     auto run = [](const std::string& cmd) {
         const int raw = std::system(cmd.c_str());
         return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;

@@ -11,7 +11,9 @@
 #include <sstream>
 #include <string>
 
+#include "atmos/error.h"
 #include "atmos/image.h"
+#include "atmos/model.h"
 #include "base/parallel.h"
 
 namespace fs = std::filesystem;
@@ -118,8 +120,8 @@ TEST(Cli, SampleFollowsTheContract) {
 
 TEST(Cli, ModelOptionsReachTheModel) {
     const std::string in = "altitude_m,mu,mu_s,azimuth_deg\n0,0.05,0.1,0\n";
-    const Result a = RunAtmos("sample --model naive --steps 4", in);
-    const Result b = RunAtmos("sample --model naive --steps 64", in);
+    const Result a = RunAtmos("sample --model naive:steps=4", in);
+    const Result b = RunAtmos("sample --model naive:steps=64", in);
     ASSERT_EQ(a.status, 0) << a.err;
     ASSERT_EQ(b.status, 0) << b.err;
     EXPECT_NE(a.out, b.out);
@@ -140,9 +142,20 @@ TEST(Cli, ErrorPaths) {
     ExpectError("render --set mie_phase_g=1.5" + o, "mie_phase_g");
     ExpectError("render --set no_such_field=1" + o, "no_such_field");
     ExpectError("render --set mie_phase_g" + o, "mie_phase_g");
-    ExpectError("render --model empty --steps 3" + o, "--steps");
-    ExpectError("render --model naive --steps 0" + o, "--steps");
-    ExpectError("render --model naive --steps many" + o, "--steps");
+    ExpectError("render --model empty:steps=3" + o, "model empty has no option 'steps'");
+    ExpectError("render --model naive:steps=0" + o,
+                "model naive: option steps must be an integer in [1, 100000], got '0'");
+    ExpectError("render --model naive:steps=many" + o, "got 'many'");
+    ExpectError("render --model naive:steps=2.5" + o, "got '2.5'");
+    ExpectError("render --model naive:steps" + o, "expected NAME:OPTION=VALUE");
+    ExpectError("render --model naive:steps=4:steps=5" + o, "given twice");
+    ExpectError("render --model atmosphere-plus:orders=0" + o,
+                "model atmosphere-plus: option orders must be an integer in [1, 20]");
+    ExpectError("render --model bruneton:scattering-mu=17" + o, "must be even");
+    ExpectError("render --model atmosphere-plus:parameterization=linear:p-u=2" + o,
+                "p-u does not apply");
+    // The old syntax (a model option as a flag) says where options go now.
+    ExpectError("render --model naive --steps 3" + o, "--model naive:steps=VALUE");
     ExpectError("render --bogus-flag" + o, "bogus");
     ExpectError("frobnicate", "frobnicate");
     ExpectError("bake --model naive -o " + (TempDir() / "bake").string(), "no precomputed tables");
@@ -193,18 +206,18 @@ TEST(Cli, FitWritesWeightsTheModelLoads) {
     const std::string w = (TempDir() / "neural_fit.json").string();
     const Result r = RunAtmos(
         "fit --model neural --reference naive --transmittance-samples 200 --scattering-samples 400 "
-        "--transmittance-steps 50 --scattering-steps 50 -o " +
+        "--transmittance-iterations 50 --scattering-iterations 50 -o " +
         w);
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("held-out"), std::string::npos) << r.out;
     const std::string png = (TempDir() / "neural_fit.png").string();
-    const Result render = RunAtmos("render --model neural --weights " + w +
+    const Result render = RunAtmos("render --model neural:weights=" + w +
                                    " --view ground-noon --size 16x9 -q -o " + png);
     EXPECT_EQ(render.status, 0) << render.err;
     ExpectError("fit --model naive -o " + w, "only --model neural");
     ExpectError("fit --model neural --reference nope -o " + w, "nope");
     ExpectError(
-        "render --model neural --weights /no/such/w.json --view ground-noon --size 16x9 -o " + png,
+        "render --model neural:weights=/no/such/w.json --view ground-noon --size 16x9 -o " + png,
         "/no/such/w.json");
     // Weights fitted to earth used with another atmosphere.
     ExpectError(
@@ -212,10 +225,64 @@ TEST(Cli, FitWritesWeightsTheModelLoads) {
         "another atmosphere");
 }
 
+// A command's --help lists its own flags only: no model's options.
 TEST(Cli, Help) {
-    const Result r = RunAtmos("render --help");
-    EXPECT_EQ(r.status, 0);
-    EXPECT_NE(r.out.find("--steps"), std::string::npos);
+    for (const char* command : {"render", "sample", "bake", "compare", "bench"}) {
+        const Result r = RunAtmos(std::string(command) + " --help");
+        EXPECT_EQ(r.status, 0) << command;
+        EXPECT_NE(r.out.find("--model"), std::string::npos) << command;
+        for (const char* model_option : {"--steps", "--orders", "--spp", "--turbidity"}) {
+            EXPECT_EQ(r.out.find(model_option), std::string::npos)
+                << command << " " << model_option;
+        }
+    }
+}
+
+// `atmos list NAME` prints the model's own option table: each option with the
+// default and range of that model's table (not another model's option of the
+// same name), and each printed default is the value the model uses when the
+// option is not given.
+TEST(Cli, ListModelPrintsItsOwnDefaults) {
+    using namespace atmos;
+    for (const ModelInfo& info : ListModels()) {
+        const Result r = RunAtmos("list " + info.name);
+        ASSERT_EQ(r.status, 0) << info.name << r.err;
+        if (info.options.empty()) {
+            EXPECT_NE(r.out.find("options: none"), std::string::npos);
+        }
+        const auto defaults = ResolveModelOptions(info.name, {});
+        ASSERT_EQ(defaults.size(), info.options.size());
+        for (size_t i = 0; i < info.options.size(); ++i) {
+            const ModelOptionSpec& spec = info.options[i];
+            EXPECT_EQ(defaults[i].first, spec.name);
+            EXPECT_EQ(defaults[i].second, spec.default_value) << info.name << " " << spec.name;
+            const std::string line = spec.name;
+            const size_t at = r.out.find("\n  " + line + " ");
+            ASSERT_NE(at, std::string::npos) << info.name << " " << spec.name << "\n" << r.out;
+            const std::string rest = r.out.substr(at, r.out.find('\n', at + 1) - at);
+            const std::string shown =
+                spec.default_value.empty() ? "default (none)" : "default " + spec.default_value;
+            EXPECT_NE(rest.find(shown), std::string::npos) << info.name << ": " << rest;
+            EXPECT_NE(rest.find(spec.Describe()), std::string::npos) << info.name << ": " << rest;
+            // The printed default, given explicitly, changes nothing (or is
+            // refused where the model's rules forbid giving it, e.g. a power
+            // of a mapping the model does not use).
+            if (!spec.default_value.empty()) {
+                try {
+                    EXPECT_EQ(ResolveModelOptions(info.name, {{spec.name, spec.default_value}}),
+                              defaults)
+                        << info.name << " " << spec.name;
+                } catch (const Error& e) {
+                    EXPECT_NE(std::string(e.what()).find("does not apply"), std::string::npos)
+                        << e.what();
+                }
+            }
+        }
+    }
+    // Two models with an option of the same name show their own defaults.
+    EXPECT_NE(RunAtmos("list atmosphere-plus").out.find("default 5"), std::string::npos);
+    EXPECT_NE(RunAtmos("list bruneton").out.find("default 4"), std::string::npos);
+    ExpectError("list nope", "unknown model 'nope'");
 }
 
 }  // namespace

@@ -40,8 +40,8 @@ std::map<std::string, std::string> SmallOptions(const char* mie_storage) {
             {"scattering-nu", "8"}, {"orders", "4"},         {"mie-storage", mie_storage}};
 }
 
-ModelOptions Options(const char* mie_storage) {
-    return ModelOptions("bruneton", BrunetonModel::StaticInfo().options, SmallOptions(mie_storage));
+BrunetonConfig Options(const char* mie_storage) {
+    return BrunetonModel::OptionRows().Parse("bruneton", SmallOptions(mie_storage));
 }
 
 void ExpectTablesAgree(const Table& cpu, const Table& gpu, const char* what) {

@@ -81,9 +81,7 @@ void ExpectLog(const std::vector<StageTime>& log, const std::vector<std::string>
     }
 }
 
-HillaireModel MakeHillaire() {
-    return HillaireModel(ModelOptions("hillaire", HillaireModel::StaticInfo().options, {}));
-}
+HillaireModel MakeHillaire() { return HillaireModel(HillaireOptions{}); }
 
 TEST(CudaStages, HillaireTablesMatchTheCpu) {
     ATMOS_SKIP_WITHOUT_DEVICE();

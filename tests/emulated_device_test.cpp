@@ -153,8 +153,8 @@ TEST(EmulatedDevice, AHostWriteNeedsHostWroteAndAResizeMakesANewTable) {
 
 TEST(EmulatedDevice, HillaireTablesAndFrameMatchTheCpu) {
     const AtmosphereParameters atm = EarthAtmosphere();
-    HillaireModel cpu(ModelOptions("hillaire", HillaireModel::StaticInfo().options, {}));
-    HillaireModel dev(ModelOptions("hillaire", HillaireModel::StaticInfo().options, {}));
+    HillaireModel cpu{HillaireOptions{}};
+    HillaireModel dev{HillaireOptions{}};
     cpu.Prepare(atm);
     {
         const BackendScope scope(Backend::kEmulatedDevice);

@@ -224,8 +224,8 @@ TEST(Cli, LocCountsTheFixture) {
 TEST(Cli, CompareWritesTablesImagesAndUsesTheCache) {
     const fs::path dir = TempDir("compare");
     const std::string args =
-        "compare --models empty,naive --views ground-noon,space --size 24x14 --reference naive "
-        "--reference-option steps=24 --reference-option light-steps=8 --cache " +
+        "compare --models empty,naive --views ground-noon,space --size 24x14 --reference "
+        "naive:steps=24:light-steps=8 --cache " +
         (dir / "cache").string() + " -o " + (dir / "out").string();
     CliRun first = Atmos(args, dir);
     ASSERT_EQ(first.status, 0) << first.err;
@@ -302,8 +302,7 @@ TEST(Cli, CompareTakesModelVariants) {
     const std::string out = (dir / "out").string();
     CliRun r = Atmos(
         "compare --models naive:steps=2,naive:steps=64:light-steps=16 --views ground-sunrise "
-        "--size 24x14 --reference naive --reference-option steps=256 --reference-option "
-        "light-steps=64 --no-cache -o " +
+        "--size 24x14 --reference naive:steps=256:light-steps=64 --no-cache -o " +
             out,
         dir);
     ASSERT_EQ(r.status, 0) << r.err;

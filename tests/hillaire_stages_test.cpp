@@ -26,9 +26,7 @@ static_assert(kIsDeviceStage<HillaireMultipleScatteringStage>, "device stage");
 static_assert(kIsDeviceStage<HillaireSkyViewStage>, "device stage");
 static_assert(kIsDeviceStage<HillaireAerialPerspectiveStage>, "device stage");
 
-HillaireModel MakeModel() {
-    return HillaireModel(ModelOptions("hillaire", HillaireModel::StaticInfo().options, {}));
-}
+HillaireModel MakeModel() { return HillaireModel(HillaireOptions{}); }
 
 std::vector<std::string> Names(const std::vector<StageTime>& log) {
     std::vector<std::string> names;

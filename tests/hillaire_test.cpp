@@ -26,7 +26,7 @@ namespace {
 
 std::unique_ptr<HillaireModel> MakeModel(const AtmosphereParameters& atm,
                                          const std::map<std::string, std::string>& given = {}) {
-    const ModelOptions options("hillaire", HillaireModel::StaticInfo().options, given);
+    const HillaireOptions options = HillaireModel::OptionRows().Parse("hillaire", given);
     auto model = std::make_unique<HillaireModel>(options);
     model->Prepare(atm);
     return model;
@@ -571,7 +571,7 @@ TEST(Hillaire, BakeRoundTrip) {
         (std::filesystem::path(ATMOS_TEST_TMP) / "hillaire_bake_roundtrip").string();
     std::filesystem::create_directories(dir);
     model.Bake(dir);
-    const ModelOptions options("hillaire", HillaireModel::StaticInfo().options, {});
+    const HillaireOptions options;
     HillaireModel loaded(options);
     loaded.LoadBaked(dir, EarthAtmosphere());
     const Table& a = model.transmittance_table();

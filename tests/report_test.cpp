@@ -58,7 +58,7 @@ TEST(Report, LoadsInHeadlessChromiumWithEveryImage) {
     const std::string compare =
         std::string(ATMOS_CLI_PATH) +
         " compare --models empty,naive --views ground-sunrise,space --size 32x18 --reference "
-        "naive --reference-option steps=24 --no-cache --quiet -o " +
+        "naive:steps=24 --no-cache --quiet -o " +
         report.string() + " > " + (dir / "compare.log").string() + " 2>&1";
     ASSERT_EQ(System(compare), 0) << Slurp(dir / "compare.log");
 

@@ -1,14 +1,15 @@
 #include "cli_common.h"
 
-#include <set>
-
 #include "atmos/error.h"
 #include "atmos/model.h"
 
 namespace atmos::cli {
 
 void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
-    cmd->add_option("--model,-m", o->model, "model name (see `atmos list`)")->capture_default_str();
+    cmd->add_option("--model,-m", o->model,
+                    "the model and its options: NAME[:OPTION=VALUE...], e.g. bruneton:orders=2 "
+                    "(`atmos list NAME` prints a model's options and defaults)")
+        ->capture_default_str();
     cmd->add_option("--atmosphere,-a", o->atmosphere, "preset name or JSON file")
         ->capture_default_str();
     cmd->add_option("--set", o->sets, "override one atmosphere field: FIELD=VALUE (repeatable)")
@@ -19,17 +20,6 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
     cmd->add_option("--load", o->load,
                     "read the model's tables from a directory written by `atmos bake` instead of "
                     "precomputing them");
-    std::set<std::string> seen;
-    for (const ModelInfo& info : ListModels()) {
-        for (const ModelOptionSpec& spec : info.options) {
-            if (!seen.insert(spec.name).second) continue;
-            o->model_option_flags[spec.name] =
-                cmd->add_option(
-                       "--" + spec.name, o->model_option_values[spec.name],
-                       spec.help + " (model " + info.name + ", default " + spec.default_value + ")")
-                    ->group("Model options");
-        }
-    }
 }
 
 void AddBackendOption(CLI::App* cmd, std::string* backend) {
@@ -39,13 +29,7 @@ void AddBackendOption(CLI::App* cmd, std::string* backend) {
         ->capture_default_str();
 }
 
-std::map<std::string, std::string> GivenModelOptions(const CommonOptions& o) {
-    std::map<std::string, std::string> given;
-    for (const auto& [name, flag] : o.model_option_flags) {
-        if (flag->count() > 0) given[name] = o.model_option_values.at(name);
-    }
-    return given;
-}
+ModelSpec GivenModel(const CommonOptions& o) { return ParseModelSpec(o.model); }
 
 // "WxH" with 1 <= W, H <= 16384.
 void ParseSize(const std::string& text, int* width, int* height) {

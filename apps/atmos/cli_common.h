@@ -17,8 +17,8 @@
 
 namespace atmos::cli {
 
-// Options every model-running command takes: --model, --atmosphere, --set,
-// --threads, --quiet, and every model's own options.
+// Options every model-running command takes: --model NAME[:OPTION=VALUE...],
+// --atmosphere, --set, --threads, --quiet, --load.
 struct CommonOptions {
     std::string model = "naive";
     std::string atmosphere = "earth";
@@ -27,10 +27,6 @@ struct CommonOptions {
     std::string backend = "cpu";  // --backend cpu|cuda (base/parallel.h)
     bool quiet = false;
     std::string load;  // --load DIR: read baked tables instead of Prepare()
-    // Model options: every option of every model is declared (so --help lists
-    // them); after parsing, those given must belong to the chosen model.
-    std::map<std::string, std::string> model_option_values;
-    std::map<std::string, CLI::Option*> model_option_flags;
 };
 
 void AddCommonOptions(CLI::App* cmd, CommonOptions* o);
@@ -38,8 +34,9 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o);
 // bench). The command selects it with a BackendScope (base/parallel.h), which
 // fails with one clear error when CUDA is not built in or no device is present.
 void AddBackendOption(CLI::App* cmd, std::string* backend);
-// The model options given on the command line (name -> text).
-std::map<std::string, std::string> GivenModelOptions(const CommonOptions& o);
+// The model of --model, parsed and validated (atmos::Error naming the option
+// and its range).
+ModelSpec GivenModel(const CommonOptions& o);
 // "WxH" with 1 <= W, H <= 16384; throws atmos::Error otherwise.
 void ParseSize(const std::string& text, int* width, int* height);
 double Seconds(std::chrono::steady_clock::time_point since);

@@ -20,7 +20,7 @@ Command AddBakeCommand(CLI::App* root) {
     AddCommonOptions(c.app, common.get());
     c.app->add_option("-o,--output", *output, "output directory")->required();
     c.run = [common, output] {
-        std::unique_ptr<Model> model = CreateModel(common->model, GivenModelOptions(*common));
+        std::unique_ptr<Model> model = CreateModel(GivenModel(*common));
         if (!model->CanBake()) Fail("model ", common->model, " has no precomputed tables to bake");
         ThreadLimit limit(common->threads);
         const AtmosphereParameters atmosphere = LoadAtmosphere(common->atmosphere, common->sets);

@@ -55,7 +55,6 @@ struct BenchOptions {
     int warmup = 1;
     int threads = 0;
     std::string backend = "cpu";
-    std::vector<std::string> options;  // NAME=VALUE, to every model that has NAME
     int prepare_repeat = 1;
     std::string stages_output;
     CLI::Option* repeat_flag = nullptr;
@@ -67,21 +66,6 @@ double Median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     const size_t n = v.size();
     return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-// --option NAME=VALUE for one model: those of its options it declares.
-std::map<std::string, std::string> OptionsFor(const std::string& model,
-                                              const std::vector<std::string>& given) {
-    std::map<std::string, std::string> out;
-    const ModelInfo& info = GetModelInfo(model);
-    for (const std::string& text : given) {
-        const size_t eq = text.find('=');
-        const std::string name = text.substr(0, eq);
-        for (const ModelOptionSpec& spec : info.options) {
-            if (spec.name == name) out[name] = text.substr(eq + 1);
-        }
-    }
-    return out;
 }
 
 // Per stage name, in first-seen order: its runs' kernel and total times.
@@ -122,21 +106,12 @@ int CmdBench(const BenchOptions& o) {
     if (o.warmup < 0) Fail("--warmup must be 0 or more");
     const Quantity quantity = ParseQuantity(o.quantity);
     const AtmosphereParameters atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
-    std::vector<std::string> models = o.models;
+    std::vector<ModelSpec> models;
+    for (const std::string& m : o.models) models.push_back(ParseModelSpec(m));
     if (models.empty()) {
         for (const ModelInfo& info : ListModels()) {
-            if (info.name != "reference") models.push_back(info.name);
+            if (info.name != "reference") models.push_back(ParseModelSpec(info.name));
         }
-    }
-    for (const std::string& m : models) GetModelInfo(m);
-    for (const std::string& text : o.options) {
-        const size_t eq = text.find('=');
-        if (eq == std::string::npos || eq == 0) Fail("--option '", text, "': expected NAME=VALUE");
-        bool used = false;
-        for (const std::string& m : models) used = used || !OptionsFor(m, {text}).empty();
-        if (!used)
-            Fail("--option '", text, "': no model of --models has an option '", text.substr(0, eq),
-                 "'");
     }
     if (o.prepare_repeat < 1) Fail("--prepare-repeat must be at least 1");
     std::vector<View> views;
@@ -186,8 +161,9 @@ int CmdBench(const BenchOptions& o) {
     };
     std::printf("%-20s %-22s %12s %12s %12s %12s %10s\n", "model", "view", "prepare_ms",
                 "median_ms", "min_ms", "max_ms", "Mpix/s");
-    for (const std::string& name : models) {
-        std::unique_ptr<Model> model = CreateModel(name, OptionsFor(name, o.options));
+    for (const ModelSpec& spec : models) {
+        const std::string& name = spec.text;
+        std::unique_ptr<Model> model = CreateModel(spec);
         const bool stochastic = model->Info().capabilities.stochastic;
         std::vector<double> prepares;
         std::vector<StageRuns> prepare_stages;
@@ -209,9 +185,8 @@ int CmdBench(const BenchOptions& o) {
         write_stages(name, "prepare", prepare_stages);
         int64_t spp = 0;
         if (stochastic) {
-            const ModelOptions opts(name, model->Info().options, OptionsFor(name, o.options));
-            for (const ModelOptionSpec& spec : model->Info().options) {
-                if (spec.name == "spp") spp = opts.GetInt("spp");
+            for (const auto& [option, value] : ResolveModelOptions(spec.name, spec.options)) {
+                if (option == "spp") spp = std::stoll(value);
             }
         }
         for (const View& view : views) {
@@ -288,12 +263,10 @@ Command AddBenchCommand(CLI::App* root) {
     auto o = std::make_shared<BenchOptions>();
     CLI::App* cmd = root->add_subcommand(
         "bench", "time Prepare() and Render() apart, per model and view (CSV + table)");
-    cmd->add_option("--models", o->models, "models (default: all but the reference)")
+    cmd->add_option("--models", o->models,
+                    "models with their options, NAME[:OPTION=VALUE...] (default: all but the "
+                    "reference; e.g. reference:spp=256,bruneton:orders=2)")
         ->delimiter(',');
-    cmd->add_option("--option", o->options,
-                    "NAME=VALUE: a model option, given to every model of --models that has it "
-                    "(repeatable; e.g. spp=256)")
-        ->allow_extra_args(false);
     cmd->add_option("--prepare-repeat", o->prepare_repeat,
                     "Prepare() runs per model; the median is reported (default 1)")
         ->capture_default_str();

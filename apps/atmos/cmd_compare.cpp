@@ -23,7 +23,7 @@ constexpr const char* kStandInReference = "naive";
 constexpr int kDefaultReferenceSpp = 64;
 
 struct CompareCliOptions {
-    std::vector<std::string> models, views, sets, reference_options;
+    std::vector<std::string> models, views, sets;
     std::string size = "320x180";
     std::string quantity = "radiance";
     std::string reference;
@@ -80,8 +80,10 @@ int CmdCompare(const CompareCliOptions& o) {
     // The reference: `reference` (the path tracer) when registered, else a stand-in.
     const bool spp_given = o.spp_flag->count() > 0;
     if (!o.reference.empty()) {
-        config.reference_model = GetModelInfo(o.reference).name;
-        config.reference_note = "chosen with --reference";
+        const ModelSpec reference = ParseModelSpec(o.reference);
+        config.reference_model = reference.name;
+        config.reference_options = reference.options;
+        config.reference_note = "chosen with --reference " + o.reference;
     } else if (IsRegistered("reference")) {
         config.reference_model = "reference";
         config.reference_note = "the path tracer";
@@ -90,13 +92,6 @@ int CmdCompare(const CompareCliOptions& o) {
         config.reference_options = {{"steps", "256"}, {"light-steps", "64"}};
         config.reference_note =
             "stand-in: the path tracer `reference` is not registered in this build";
-    }
-    for (const std::string& kv : o.reference_options) {
-        const size_t eq = kv.find('=');
-        if (eq == std::string::npos || eq == 0) {
-            Fail("--reference-option expects NAME=VALUE, got '", kv, "'");
-        }
-        config.reference_options[kv.substr(0, eq)] = kv.substr(eq + 1);
     }
     if (HasOption(config.reference_model, "spp")) {
         if (config.reference_options.count("spp") == 0) {
@@ -144,11 +139,8 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
                       ->capture_default_str()
                       ->check(CLI::PositiveNumber);
     cmd->add_option("--reference", o->reference,
-                    "reference model (default: `reference` when registered, else naive with "
-                    "--steps 256 --light-steps 64)");
-    cmd->add_option("--reference-option", o->reference_options,
-                    "a model option of the reference, NAME=VALUE (repeatable)")
-        ->allow_extra_args(false);
+                    "reference model and its options, NAME[:OPTION=VALUE...] (default: "
+                    "`reference` when registered, else naive:steps=256:light-steps=64)");
     cmd->add_option("--atmosphere,-a", o->atmosphere, "preset name or JSON file")
         ->capture_default_str();
     cmd->add_option("--set", o->sets, "override one atmosphere field: FIELD=VALUE (repeatable)")

@@ -37,10 +37,12 @@ int CmdFit(const FitOptions& o) {
     if (o.output.empty()) Fail("fit: -o FILE.json is required");
     ThreadLimit limit(o.threads);
     const AtmosphereParameters atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
-    std::map<std::string, std::string> ref_options;
-    if (o.reference == "reference") ref_options["spp"] = std::to_string(o.reference_spp);
-    // CreateModel rejects an unknown name with one clear error.
-    std::unique_ptr<Model> reference = CreateModel(o.reference, ref_options);
+    ModelSpec spec = ParseModelSpec(o.reference);
+    if (spec.name == o.model) Fail("fit: --reference cannot be the model being fitted");
+    if (spec.name == "reference" && spec.options.count("spp") == 0) {
+        spec.options["spp"] = std::to_string(o.reference_spp);
+    }
+    std::unique_ptr<Model> reference = CreateModel(spec);
     const auto t0 = std::chrono::steady_clock::now();
     reference->Prepare(atmosphere);
     const double prepare_s = Seconds(t0);
@@ -90,8 +92,8 @@ Command AddFitCommand(CLI::App* root) {
     c.app->add_option("--set", o->sets, "override an atmosphere field: FIELD=VALUE");
     c.app
         ->add_option("--reference", o->reference,
-                     "model sampled for the training data: bruneton (fast) or reference (path "
-                     "tracer)")
+                     "model sampled for the training data, NAME[:OPTION=VALUE...]: bruneton "
+                     "(fast) or reference (path tracer)")
         ->capture_default_str();
     c.app->add_option("--reference-spp", o->reference_spp, "samples per query for the path tracer")
         ->capture_default_str();
@@ -102,9 +104,13 @@ Command AddFitCommand(CLI::App* root) {
     c.app->add_option("--transmittance-samples", o->fit.transmittance_samples)
         ->capture_default_str();
     c.app->add_option("--scattering-samples", o->fit.scattering_samples)->capture_default_str();
-    c.app->add_option("--transmittance-steps", o->fit.transmittance_steps, "Adam steps")
+    c.app
+        ->add_option("--transmittance-iterations", o->fit.transmittance_steps,
+                     "Adam iterations of the transmittance network")
         ->capture_default_str();
-    c.app->add_option("--scattering-steps", o->fit.scattering_steps, "Adam steps")
+    c.app
+        ->add_option("--scattering-iterations", o->fit.scattering_steps,
+                     "Adam iterations of the scattering network")
         ->capture_default_str();
     c.app->add_option("--batch", o->fit.batch, "mini-batch size")->capture_default_str();
     c.app->add_option("--learning-rate", o->fit.learning_rate, "Adam step size")

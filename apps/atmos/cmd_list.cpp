@@ -27,22 +27,53 @@ namespace atmos::cli {
 
 namespace {
 
-int CmdList() {
-    std::printf("models:\n");
+void PrintCapabilities(const ModelInfo& info) {
+    const ModelCapabilities& c = info.capabilities;
+    std::printf(
+        "  %-16s   quantities: %s%s%s; space views: %s; sun below horizon: %s; "
+        "multiple scattering: %s%s%s\n",
+        "", c.radiance ? "radiance" : "", c.radiance && c.transmittance ? ", " : "",
+        c.transmittance ? "transmittance" : "", c.space_views ? "yes" : "no",
+        c.sun_below_horizon ? "yes" : "no", c.multiple_scattering ? "yes" : "no",
+        c.precomputed ? "; precomputed" : "", c.stochastic ? "; Monte Carlo" : "");
+}
+
+// `atmos list NAME`: one model with its option table (its own defaults).
+int CmdListModel(const std::string& name, bool markdown) {
+    const ModelInfo& info = GetModelInfo(name);
+    if (markdown) {
+        std::printf("%s", OptionsMarkdown(info.options).c_str());
+        return 0;
+    }
+    std::printf("%s: %s\n", info.name.c_str(), info.title.c_str());
+    std::printf("  %s\n  source: %s\n", info.summary.c_str(), info.citation.c_str());
+    PrintCapabilities(info);
+    if (info.options.empty()) {
+        std::printf("options: none\n");
+        return 0;
+    }
+    std::printf("options (--model %s:OPTION=VALUE[:OPTION=VALUE...]):\n", info.name.c_str());
+    for (const ModelOptionSpec& spec : info.options) {
+        std::printf("  %-22s %s, default %s%s\n", spec.name.c_str(), spec.Describe().c_str(),
+                    spec.default_value.empty() ? "(none)" : spec.default_value.c_str(),
+                    spec.shapes_tables ? "; shapes the baked tables" : "");
+        std::printf("  %-22s %s\n", "", spec.help.c_str());
+    }
+    return 0;
+}
+
+int CmdList(const std::string& name, bool markdown) {
+    if (!name.empty()) return CmdListModel(name, markdown);
+    if (markdown) Fail("list: --markdown needs a model name (atmos list NAME --markdown)");
+    std::printf("models (`atmos list NAME` prints one model's options):\n");
     for (const ModelInfo& info : ListModels()) {
-        const ModelCapabilities& c = info.capabilities;
         std::printf("  %-16s %s\n", info.name.c_str(), info.title.c_str());
         std::printf("  %-16s   %s\n", "", info.summary.c_str());
         std::printf("  %-16s   source: %s\n", "", info.citation.c_str());
-        std::printf(
-            "  %-16s   quantities: %s%s%s; space views: %s; sun below horizon: %s; "
-            "multiple scattering: %s\n",
-            "", c.radiance ? "radiance" : "", c.radiance && c.transmittance ? ", " : "",
-            c.transmittance ? "transmittance" : "", c.space_views ? "yes" : "no",
-            c.sun_below_horizon ? "yes" : "no", c.multiple_scattering ? "yes" : "no");
+        PrintCapabilities(info);
         for (const ModelOptionSpec& spec : info.options) {
-            std::printf("  %-16s   --%s (default %s): %s\n", "", spec.name.c_str(),
-                        spec.default_value.c_str(), spec.help.c_str());
+            std::printf("  %-16s   %s=%s: %s\n", "", spec.name.c_str(), spec.default_value.c_str(),
+                        spec.help.c_str());
         }
     }
     std::printf("views:\n");
@@ -51,7 +82,7 @@ int CmdList() {
                     v.description.c_str());
     }
     std::printf("atmospheres:\n");
-    for (const std::string& name : AtmospherePresetNames()) std::printf("  %s\n", name.c_str());
+    for (const std::string& preset : AtmospherePresetNames()) std::printf("  %s\n", preset.c_str());
     return 0;
 }
 
@@ -59,8 +90,14 @@ int CmdList() {
 
 Command AddListCommand(CLI::App* root) {
     Command c;
-    c.app = root->add_subcommand("list", "list models, views and atmosphere presets");
-    c.run = [] { return CmdList(); };
+    auto name = std::make_shared<std::string>();
+    auto markdown = std::make_shared<bool>(false);
+    c.app = root->add_subcommand(
+        "list", "list models, views and atmosphere presets; `list NAME`: one model's options");
+    c.app->add_option("model", *name, "a model: print its options with their defaults and ranges");
+    c.app->add_flag("--markdown", *markdown,
+                    "with a model: its option table as Markdown (as in docs/models/NAME.md)");
+    c.run = [name, markdown] { return CmdList(*name, *markdown); };
     return c;
 }
 

@@ -52,7 +52,7 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     ThreadLimit limit(common.threads);
     const BackendScope backend(ParseBackend(common.backend));
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
-    std::unique_ptr<Model> model = CreateModel(common.model, GivenModelOptions(common));
+    std::unique_ptr<Model> model = CreateModel(GivenModel(common));
     std::vector<View> views;
     if (all_views) {
         views = StandardViews(atmosphere);

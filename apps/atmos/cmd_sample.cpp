@@ -90,7 +90,7 @@ int CmdSample(const CommonOptions& common) {
     ThreadLimit limit(common.threads);
     const BackendScope backend(ParseBackend(common.backend));
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
-    std::unique_ptr<Model> model = CreateModel(common.model, GivenModelOptions(common));
+    std::unique_ptr<Model> model = CreateModel(GivenModel(common));
     const std::vector<SampleQuery> queries = ReadQueries(std::cin);
     PrepareModel(common, atmosphere, model.get());
     const std::vector<SampleAnswer> answers = model->Sample(queries);

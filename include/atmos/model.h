@@ -15,6 +15,7 @@
 #include "atmos/atmosphere.h"
 #include "atmos/image.h"
 #include "atmos/math.h"
+#include "atmos/options.h"
 #include "atmos/view.h"
 
 namespace atmos {
@@ -34,48 +35,25 @@ struct ModelCapabilities {
     bool stochastic = false;   // Monte Carlo: output depends on --seed / --spp
 };
 
-// One option a model accepts on the command line (`--NAME VALUE`), for both
-// `render` and `sample`.
-struct ModelOptionSpec {
-    enum class Type { kInteger, kReal, kChoice, kText };
-    std::string name;  // without the leading "--"
-    Type type = Type::kInteger;
-    std::string default_value;
-    std::string help;
-    double min = 0.0;  // integer / real: allowed range [min, max]
-    double max = 0.0;
-    std::vector<std::string> choices;  // kChoice
-};
-
 struct ModelInfo {
     std::string name;      // registry name, e.g. "naive"
     std::string title;     // e.g. "Naive single scattering (Nishita 93)"
     std::string citation;  // paper + seed section
     std::string summary;   // one line
     ModelCapabilities capabilities;
-    std::vector<ModelOptionSpec> options;
+    std::vector<ModelOptionSpec> options;  // from the model's OptionTable (atmos/options.h)
 };
 
-// Validated option values of one model: every option of its spec, set or at
-// its default. Built by CreateModel from the user's strings.
-class ModelOptions {
-  public:
-    ModelOptions() = default;
-    // Validates `given` (name -> text) against `specs`; throws atmos::Error for an
-    // unknown option or a value outside its type or range.
-    ModelOptions(const std::string& model_name, const std::vector<ModelOptionSpec>& specs,
-                 const std::map<std::string, std::string>& given);
-
-    int GetInt(const std::string& name) const;
-    double GetReal(const std::string& name) const;
-    const std::string& GetText(const std::string& name) const;
-    bool WasSet(const std::string& name) const { return set_.count(name) != 0; }
-    const std::map<std::string, std::string>& values() const { return values_; }
-
-  private:
-    std::map<std::string, std::string> values_;
-    std::map<std::string, bool> set_;
+// A model with options, as written everywhere (command line, compare, bench):
+// NAME[:OPTION=VALUE[:OPTION=VALUE...]], e.g. "bruneton:orders=2".
+struct ModelSpec {
+    std::string text;                            // as given
+    std::string name;                            // the registered name
+    std::map<std::string, std::string> options;  // as given (name -> text)
 };
+// Parses and validates a spec (unknown model or option, malformed item, value
+// out of range, option given twice: atmos::Error naming the model and the range).
+ModelSpec ParseModelSpec(const std::string& text);
 
 // One `atmos sample` query (DESIGN.md): camera at (0, 0, bottom + altitude),
 // view (sqrt(1 - mu^2), 0, mu), sun (sqrt(1 - mu_s^2) cos az, sqrt(1 - mu_s^2) sin az, mu_s).
@@ -132,8 +110,14 @@ class Model {
 // All registered models, in the registry's order (src/atmos/models/registry.cpp).
 std::vector<ModelInfo> ListModels();
 const ModelInfo& GetModelInfo(const std::string& name);  // throws for an unknown name
-// Creates a model by name with options `--NAME VALUE` given as name -> text.
+// Creates a model by name with options given as name -> text (validated by its
+// option table; throws atmos::Error naming the option and its range).
 std::unique_ptr<Model> CreateModel(const std::string& name,
                                    const std::map<std::string, std::string>& options = {});
+std::unique_ptr<Model> CreateModel(const ModelSpec& spec);
+// Every option of the model with `given` applied: (name, canonical text), in
+// its table's order (defaults included). Throws like CreateModel.
+std::vector<std::pair<std::string, std::string>> ResolveModelOptions(
+    const std::string& name, const std::map<std::string, std::string>& given);
 
 }  // namespace atmos

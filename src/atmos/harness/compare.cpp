@@ -169,30 +169,6 @@ void WriteMetricCsv(const std::string& path, const std::string& corner,
     if (!f) Fail("cannot write '", path, "'");
 }
 
-ModelSpec ParseModelSpec(const std::string& text) {
-    ModelSpec spec;
-    spec.text = text;
-    size_t at = text.find(':');
-    spec.name = text.substr(0, at);
-    const ModelInfo& info = GetModelInfo(spec.name);
-    while (at != std::string::npos) {
-        const size_t next = text.find(':', at + 1);
-        const std::string item =
-            text.substr(at + 1, next == std::string::npos ? next : next - at - 1);
-        const size_t eq = item.find('=');
-        if (eq == std::string::npos || eq == 0) {
-            Fail("model '", text, "': expected NAME:OPTION=VALUE[:OPTION=VALUE...], got '", item,
-                 "'");
-        }
-        if (!spec.options.emplace(item.substr(0, eq), item.substr(eq + 1)).second) {
-            Fail("model '", text, "': option '", item.substr(0, eq), "' given twice");
-        }
-        at = next;
-    }
-    ModelOptions(info.name, info.options, spec.options);  // validates names and values
-    return spec;
-}
-
 CompareResult RunCompare(const CompareConfig& config) {
     const auto start = std::chrono::steady_clock::now();
     CompareResult result;
@@ -228,7 +204,7 @@ CompareResult RunCompare(const CompareConfig& config) {
         result.models.push_back(spec.text);
         result.model_names.push_back(spec.name);
         std::string title = GetModelInfo(spec.name).title;
-        for (const auto& [option, value] : spec.options) title += ", --" + option + " " + value;
+        for (const auto& [option, value] : spec.options) title += ", " + option + "=" + value;
         result.model_titles.push_back(title);
     }
     const std::vector<std::string> view_names =

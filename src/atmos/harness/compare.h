@@ -93,18 +93,9 @@ std::string CompareRowLabel(const std::string& view, Quantity quantity);
 std::string ValidityNote(const ModelCapabilities& caps, const View& view,
                          const AtmosphereParameters& atmosphere);
 
-// A model to compare: a registered name, optionally with options after colons,
-// `NAME[:OPTION=VALUE]...` (e.g. `hillaire:segment-offset=0.5`), so that
-// variants of one model are compared side by side. The spec text names the
-// model's column and files.
-struct ModelSpec {
-    std::string text;
-    std::string name;
-    std::map<std::string, std::string> options;
-};
-// Parses and validates a spec (unknown model, unknown option, bad value: one
-// atmos::Error).
-ModelSpec ParseModelSpec(const std::string& text);
+// Models to compare are ModelSpecs (atmos/model.h): `NAME[:OPTION=VALUE]...`
+// (e.g. `hillaire:segment-offset=0.5`), so that variants of one model are
+// compared side by side; the spec text names the model's column and files.
 
 // Runs the comparison and writes images, error maps, flip.csv, rmse.csv,
 // times.csv and index.html into config.output_dir. Throws atmos::Error.

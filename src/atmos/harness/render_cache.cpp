@@ -57,8 +57,9 @@ std::uint64_t Fnv1a64(const std::string& text) {
 
 std::map<std::string, std::string> ResolvedModelOptions(
     const std::string& model, const std::map<std::string, std::string>& given) {
-    const ModelInfo& info = GetModelInfo(model);
-    return ModelOptions(info.name, info.options, given).values();
+    std::map<std::string, std::string> resolved;
+    for (const auto& [name, value] : ResolveModelOptions(model, given)) resolved[name] = value;
+    return resolved;
 }
 
 RenderCache::RenderCache(std::string directory) : directory_(std::move(directory)) {}

@@ -15,6 +15,7 @@
 #include "base/parallel.h"
 #include "io/table_io.h"
 #include "models/atmosphere_plus_stages.h"
+#include "models/option_json.h"
 #include "render/stages.h"
 
 namespace atmos {
@@ -26,15 +27,7 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 }
 
 void CheckSettings(const AplusSettings& s) {
-    if (s.width < 2 || s.height < 2 || s.depth < 2)
-        Fail("atmosphere-plus: table sizes must be >= 2");
-    if (s.transmittance_width < 2 || s.transmittance_height < 2) {
-        Fail("atmosphere-plus: transmittance table sizes must be >= 2");
-    }
-    if (s.orders < 1) Fail("atmosphere-plus: --orders must be >= 1");
-    if (s.transmittance_steps < 1 || s.gather_theta < 1 || s.gather_phi < 1) {
-        Fail("atmosphere-plus: integration step counts must be >= 1");
-    }
+    AtmospherePlusModel::OptionRows().Check("atmosphere-plus", s);
 }
 
 }  // namespace
@@ -91,7 +84,6 @@ AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings
 }
 
 ModelInfo AtmospherePlusModel::StaticInfo() {
-    using T = ModelOptionSpec::Type;
     ModelInfo info;
     info.name = "atmosphere-plus";
     info.title = "Atmosphere Plus (3D table without azimuth)";
@@ -101,136 +93,98 @@ ModelInfo AtmospherePlusModel::StaticInfo() {
         "by gathering; phase functions at render time";
     info.capabilities.multiple_scattering = true;
     info.capabilities.precomputed = true;
-    info.options = {
-        {"parameterization",
-         T::kChoice,
-         "horizon",
-         "table mapping (seed 000 2.4)",
-         0,
-         0,
-         {"linear", "nonlinear", "power", "horizon"}},
-        {"table-width", T::kInteger, "32", "table size over altitude (u)", 2, 1024, {}},
-        {"table-height",
-         T::kInteger,
-         "64",
-         "table size over view zenith (v): 256, 128 or 64",
-         2,
-         4096,
-         {}},
-        {"table-depth", T::kInteger, "32", "table size over sun zenith (w)", 2, 1024, {}},
-        {"transmittance-width",
-         T::kInteger,
-         "64",
-         "transmittance table size over altitude",
-         2,
-         4096,
-         {}},
-        {"transmittance-height",
-         T::kInteger,
-         "256",
-         "transmittance table size over view zenith",
-         2,
-         4096,
-         {}},
-        {"orders", T::kInteger, "5", "scattering orders K", 1, 20, {}},
-        {"transmittance-steps",
-         T::kInteger,
-         "30",
-         "trapezoidal intervals along rays (seed: 30)",
-         1,
-         10000,
-         {}},
-        {"gather-theta",
-         T::kInteger,
-         "6",
-         "2D trapezoid intervals over Theta in [0, pi]",
-         1,
-         1000,
-         {}},
-        {"gather-phi",
-         T::kInteger,
-         "12",
-         "2D trapezoid intervals over Phi in [0, 2 pi]",
-         1,
-         2000,
-         {}},
-        {"p-u", T::kReal, "2", "power p_u of u (power, horizon)", 0.1, 10, {}},
-        {"p-v", T::kReal, "3", "power p_v of v (power)", 0.1, 10, {}},
-        {"p-w", T::kReal, "3", "power p_w of w (power, horizon)", 0.1, 10, {}},
-        {"p-a", T::kReal, "3", "atmosphere power p_a (horizon)", 0.1, 10, {}},
-        {"p-s", T::kReal, "3", "surface power p_s (horizon)", 0.1, 10, {}},
-        {"surface-ratio",
-         T::kReal,
-         "0.5",
-         "s: most texture space for surfaces (horizon)",
-         0,
-         0.99,
-         {}},
-        {"horizon-angle",
-         T::kChoice,
-         "geometric",
-         "horizon cosine of the horizon mapping: geometric -sqrt(1-(Rp/r)^2) or the seed's "
-         "-1+Rp/r",
-         0,
-         0,
-         {"geometric", "seed"}},
-        {"rayleigh-phase",
-         T::kChoice,
-         "standard",
-         "render-time Rayleigh phase: standard 3/4(1+c^2) or modified 0.8(1.4+0.5c^2) (seed 000 "
-         "1.7)",
-         0,
-         0,
-         {"standard", "modified"}},
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-AplusSettings AplusSettingsFromOptions(const ModelOptions& o) {
-    AplusSettings s;
-    const std::string& p = o.GetText("parameterization");
-    s.mapping.kind = p == "linear"      ? AplusParameterization::kLinear
-                     : p == "nonlinear" ? AplusParameterization::kNonlinear
-                     : p == "power"     ? AplusParameterization::kPower
-                                        : AplusParameterization::kHorizon;
-    s.mapping.horizon_angle = o.GetText("horizon-angle") == "seed" ? AplusHorizonAngle::kSeed
-                                                                   : AplusHorizonAngle::kGeometric;
-    // Options that the chosen mapping ignores are errors, not silent no-ops.
-    const bool power = s.mapping.kind == AplusParameterization::kPower;
-    const bool horizon = s.mapping.kind == AplusParameterization::kHorizon;
-    for (const char* name : {"p-u", "p-v", "p-w", "p-a", "p-s", "surface-ratio", "horizon-angle"}) {
-        const std::string n = name;
-        const bool used = (n == "p-u" || n == "p-w") ? (power || horizon)
-                          : n == "p-v"               ? power
-                                                     : horizon;
-        if (o.WasSet(n) && !used) {
-            Fail("atmosphere-plus: --", n, " does not apply to --parameterization ", p,
-                 " (p-u, p-w: power and horizon; p-v: power; p-a, p-s, surface-ratio, "
-                 "horizon-angle: horizon)");
-        }
-    }
-    s.mapping.p_u = o.GetReal("p-u");
-    s.mapping.p_v = o.GetReal("p-v");
-    s.mapping.p_w = o.GetReal("p-w");
-    s.mapping.p_a = o.GetReal("p-a");
-    s.mapping.p_s = o.GetReal("p-s");
-    s.mapping.s = o.GetReal("surface-ratio");
-    s.width = o.GetInt("table-width");
-    s.height = o.GetInt("table-height");
-    s.depth = o.GetInt("table-depth");
-    s.transmittance_width = o.GetInt("transmittance-width");
-    s.transmittance_height = o.GetInt("transmittance-height");
-    s.orders = o.GetInt("orders");
-    s.transmittance_steps = o.GetInt("transmittance-steps");
-    s.gather_theta = o.GetInt("gather-theta");
-    s.gather_phi = o.GetInt("gather-phi");
-    s.modified_rayleigh = o.GetText("rayleigh-phase") == "modified";
-    CheckSettings(s);
-    return s;
+const OptionTable<AplusSettings>& AtmospherePlusModel::OptionRows() {
+    using S = AplusSettings;
+    using P = AplusParameterization;
+    auto mapping = [](auto member) {
+        return [member](S& s) -> decltype(s.mapping.*member)& { return s.mapping.*member; };
+    };
+    static const auto table =
+        OptionTable<S>()
+            .Choice("parameterization", mapping(&AplusMapping::kind),
+                    {{"linear", P::kLinear},
+                     {"nonlinear", P::kNonlinear},
+                     {"power", P::kPower},
+                     {"horizon", P::kHorizon}},
+                    "table mapping (seed 000 2.4)")
+            .ShapesTables()
+            .Integer("table-width", &S::width, 2, 1024, "", "table size over altitude (u)")
+            .ShapesTables()
+            .Integer("table-height", &S::height, 2, 4096, "",
+                     "table size over view zenith (v): 256, 128 or 64")
+            .ShapesTables()
+            .Integer("table-depth", &S::depth, 2, 1024, "", "table size over sun zenith (w)")
+            .ShapesTables()
+            .Integer("transmittance-width", &S::transmittance_width, 2, 4096, "",
+                     "transmittance table size over altitude")
+            .ShapesTables()
+            .Integer("transmittance-height", &S::transmittance_height, 2, 4096, "",
+                     "transmittance table size over view zenith")
+            .ShapesTables()
+            .Integer("orders", &S::orders, 1, 20, "", "scattering orders K")
+            .ShapesTables()
+            .Integer("transmittance-steps", &S::transmittance_steps, 1, 10000, "",
+                     "trapezoidal intervals along rays (seed: 30)")
+            .ShapesTables()
+            .Integer("gather-theta", &S::gather_theta, 1, 1000, "",
+                     "2D trapezoid intervals over Theta in [0, pi]")
+            .ShapesTables()
+            .Integer("gather-phi", &S::gather_phi, 1, 2000, "",
+                     "2D trapezoid intervals over Phi in [0, 2 pi]")
+            .ShapesTables()
+            .Real("p-u", mapping(&AplusMapping::p_u), 0.1, 10, "",
+                  "power p_u of u (power, horizon)")
+            .ShapesTables()
+            .Real("p-v", mapping(&AplusMapping::p_v), 0.1, 10, "", "power p_v of v (power)")
+            .ShapesTables()
+            .Real("p-w", mapping(&AplusMapping::p_w), 0.1, 10, "",
+                  "power p_w of w (power, horizon)")
+            .ShapesTables()
+            .Real("p-a", mapping(&AplusMapping::p_a), 0.1, 10, "", "atmosphere power p_a (horizon)")
+            .ShapesTables()
+            .Real("p-s", mapping(&AplusMapping::p_s), 0.1, 10, "", "surface power p_s (horizon)")
+            .ShapesTables()
+            .Real("surface-ratio", mapping(&AplusMapping::s), 0, 0.99, "",
+                  "s: most texture space for surfaces (horizon)")
+            .ShapesTables()
+            .Choice(
+                "horizon-angle", mapping(&AplusMapping::horizon_angle),
+                {{"geometric", AplusHorizonAngle::kGeometric}, {"seed", AplusHorizonAngle::kSeed}},
+                "horizon cosine of the horizon mapping: geometric -sqrt(1-(Rp/r)^2) or the "
+                "seed's -1+Rp/r")
+            .ShapesTables()
+            .Choice("rayleigh-phase", &S::modified_rayleigh,
+                    {{"standard", false}, {"modified", true}},
+                    "render-time Rayleigh phase: standard 3/4(1+c^2) or modified 0.8(1.4+0.5c^2) "
+                    "(seed 000 1.7)")
+            // Options that the chosen mapping ignores are errors, not silent no-ops.
+            .Validate([](const std::string& model, const S& s, const std::set<std::string>& given) {
+                const P kind = s.mapping.kind;
+                const bool power = kind == P::kPower;
+                const bool horizon = kind == P::kHorizon;
+                for (const char* name :
+                     {"p-u", "p-v", "p-w", "p-a", "p-s", "surface-ratio", "horizon-angle"}) {
+                    const std::string n = name;
+                    const bool used = (n == "p-u" || n == "p-w") ? (power || horizon)
+                                      : n == "p-v"               ? power
+                                                                 : horizon;
+                    if (given.count(n) && !used) {
+                        Fail("model ", model, ": option ", n,
+                             " does not apply to this parameterization (p-u, p-w: power and "
+                             "horizon; p-v: power; p-a, p-s, surface-ratio, horizon-angle: "
+                             "horizon)");
+                    }
+                }
+            });
+    return table;
 }
 
-AtmospherePlusModel::AtmospherePlusModel(const ModelOptions& options)
-    : info_(StaticInfo()), settings_(AplusSettingsFromOptions(options)) {
+AtmospherePlusModel::AtmospherePlusModel(const AplusSettings& options)
+    : info_(StaticInfo()), settings_(options) {
     atm_ = EarthAtmosphere();
 }
 
@@ -243,25 +197,11 @@ void AtmospherePlusModel::Prepare(const AtmosphereParameters& atmosphere) {
 
 namespace {
 
-// Everything that determines the tables' content, for the bake's JSON.
+// The bake's "options": every option (those that shape the tables are checked
+// by LoadBaked).
 nlohmann::json SettingsJson(const AplusSettings& s) {
-    const char* kinds[] = {"linear", "nonlinear", "power", "horizon"};
-    const AplusMapping& m = s.mapping;
-    nlohmann::json j;
-    j["parameterization"] = kinds[static_cast<int>(m.kind)];
-    j["horizon_angle"] = m.horizon_angle == AplusHorizonAngle::kSeed ? "seed" : "geometric";
-    j["p_u"] = m.p_u;
-    j["p_v"] = m.p_v;
-    j["p_w"] = m.p_w;
-    j["p_a"] = m.p_a;
-    j["p_s"] = m.p_s;
-    j["surface_ratio"] = m.s;
-    j["table_size"] = {s.width, s.height, s.depth};
-    j["transmittance_size"] = {s.transmittance_width, s.transmittance_height};
-    j["orders"] = s.orders;
-    j["transmittance_steps"] = s.transmittance_steps;
-    j["gather"] = {s.gather_theta, s.gather_phi};
-    return j;
+    const auto& table = AtmospherePlusModel::OptionRows();
+    return nlohmann::json::parse(OptionsJson(table.Specs(), table.Values(s)).dump());
 }
 
 }  // namespace
@@ -273,7 +213,8 @@ void AtmospherePlusModel::Bake(const std::string& directory) const {
     WriteTableExr(tables_.transmittance, (fs::path(directory) / "transmittance.exr").string());
     nlohmann::json j;
     j["model"] = "atmosphere-plus";
-    j["settings"] = SettingsJson(settings_);
+    j["format_version"] = 2;  // 2: "options" from the option table
+    j["options"] = SettingsJson(settings_);
     j["scattering"] = {
         {"file", "scattering.exr"},
         {"layout",
@@ -305,10 +246,13 @@ void AtmospherePlusModel::LoadBaked(const std::string& directory,
     AplusSettings s = settings_;
     s.mapping.bottom_radius = atmosphere.bottom_radius;
     s.mapping.height = atmosphere.top_radius - atmosphere.bottom_radius;
-    if (!j.contains("settings") || j["settings"] != SettingsJson(s)) {
-        Fail("atmosphere-plus: the tables in ", directory, " were baked with other model options (",
-             j.value("settings", nlohmann::json()).dump(), ")");
+    if (!j.contains("format_version") || j["format_version"] != 2 || !j.contains("options")) {
+        Fail("atmosphere-plus: the tables in ", directory,
+             " were baked by another version of atmos (format_version ",
+             j.value("format_version", nlohmann::json()).dump(), ", expected 2): bake them again");
     }
+    CheckBakedOptions(json_path.string(), nlohmann::ordered_json::parse(j["options"].dump()),
+                      OptionRows().Specs(), OptionRows().Values(s));
     if (!j.contains("atmosphere") ||
         j["atmosphere"] != nlohmann::json::parse(AtmosphereToJson(atmosphere))) {
         Fail("atmosphere-plus: the tables in ", directory, " were baked for another atmosphere");

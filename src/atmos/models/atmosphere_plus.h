@@ -310,12 +310,11 @@ struct AtmospherePlusDirectEvaluator {
     }
 };
 
-// Settings from the model's options (throws atmos::Error for bad combinations).
-AplusSettings AplusSettingsFromOptions(const ModelOptions& options);
-
 class AtmospherePlusModel : public EvaluatorModel<AtmospherePlusModel> {
   public:
-    explicit AtmospherePlusModel(const ModelOptions& options);
+    using Options = AplusSettings;
+    static const OptionTable<AplusSettings>& OptionRows();
+    explicit AtmospherePlusModel(const AplusSettings& options);
     static ModelInfo StaticInfo();
     const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override;

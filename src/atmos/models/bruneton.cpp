@@ -9,19 +9,14 @@
 
 #include "atmos/error.h"
 #include "io/table_io.h"
+#include "models/option_json.h"
 
 namespace atmos {
 
 namespace {
 
 constexpr const char* kBakeJson = "bruneton.json";
-constexpr int kBakeFormatVersion = 1;
-
-ModelOptionSpec IntOption(const char* name, int def, const char* help, int lo, int hi) {
-    return {
-        name, ModelOptionSpec::Type::kInteger, std::to_string(def), help, double(lo), double(hi),
-        {}};
-}
+constexpr int kBakeFormatVersion = 2;  // 2: "options" keyed by option name
 
 }  // namespace
 
@@ -36,48 +31,58 @@ ModelInfo BrunetonModel::StaticInfo() {
         "4D scattering tables (packed 3D), transmittance and irradiance tables, N orders";
     info.capabilities.multiple_scattering = true;
     info.capabilities.precomputed = true;
-    const BrunetonConfig d;
-    info.options = {
-        IntOption("orders", d.orders, "scattering orders (1 = single scattering)", 1, 32),
-        IntOption("scattering-samples", d.scattering_samples,
-                  "trapezoid intervals along view rays in single and multiple scattering", 1, 1000),
-        {"mie-storage",
-         ModelOptionSpec::Type::kChoice,
-         "separate",
-         "single Mie scattering in its own table, or combined (red in the scattering table's "
-         "alpha, green and blue extrapolated)",
-         0,
-         0,
-         {"separate", "combined"}},
-        IntOption("transmittance-width", d.transmittance_width, "transmittance table: mu texels", 2,
-                  4096),
-        IntOption("transmittance-height", d.transmittance_height, "transmittance table: r texels",
-                  2, 4096),
-        IntOption("irradiance-width", d.irradiance_width, "irradiance table: mu_s texels", 2, 4096),
-        IntOption("irradiance-height", d.irradiance_height, "irradiance table: r texels", 2, 4096),
-        IntOption("scattering-r", d.scattering_r, "scattering table: r texels", 2, 1024),
-        IntOption("scattering-mu", d.scattering_mu, "scattering table: mu texels (even)", 4, 4096),
-        IntOption("scattering-mu-s", d.scattering_mu_s, "scattering table: mu_s texels", 2, 1024),
-        IntOption("scattering-nu", d.scattering_nu, "scattering table: nu texels", 2, 1024),
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-BrunetonModel::BrunetonModel(const ModelOptions& options)
-    : info_(StaticInfo()), atm_(EarthAtmosphere()) {
-    config_.orders = options.GetInt("orders");
-    config_.scattering_samples = options.GetInt("scattering-samples");
-    config_.combined_mie = options.GetText("mie-storage") == "combined";
-    config_.transmittance_width = options.GetInt("transmittance-width");
-    config_.transmittance_height = options.GetInt("transmittance-height");
-    config_.irradiance_width = options.GetInt("irradiance-width");
-    config_.irradiance_height = options.GetInt("irradiance-height");
-    config_.scattering_r = options.GetInt("scattering-r");
-    config_.scattering_mu = options.GetInt("scattering-mu");
-    config_.scattering_mu_s = options.GetInt("scattering-mu-s");
-    config_.scattering_nu = options.GetInt("scattering-nu");
-    ValidateBrunetonConfig(config_);
+const OptionTable<BrunetonConfig>& BrunetonModel::OptionRows() {
+    using C = BrunetonConfig;
+    static const auto table =
+        OptionTable<C>()
+            .Integer("orders", &C::orders, 1, 32, "", "scattering orders (1 = single scattering)")
+            .ShapesTables()
+            .Integer("scattering-samples", &C::scattering_samples, 1, 1000, "",
+                     "trapezoid intervals along view rays in single and multiple scattering")
+            .ShapesTables()
+            .Choice("mie-storage", &C::combined_mie, {{"separate", false}, {"combined", true}},
+                    "single Mie scattering in its own table, or combined (red in the scattering "
+                    "table's alpha, green and blue extrapolated)")
+            .ShapesTables()
+            .Integer("transmittance-width", &C::transmittance_width, 2, 4096, "",
+                     "transmittance table: mu texels")
+            .ShapesTables()
+            .Integer("transmittance-height", &C::transmittance_height, 2, 4096, "",
+                     "transmittance table: r texels")
+            .ShapesTables()
+            .Integer("irradiance-width", &C::irradiance_width, 2, 4096, "",
+                     "irradiance table: mu_s texels")
+            .ShapesTables()
+            .Integer("irradiance-height", &C::irradiance_height, 2, 4096, "",
+                     "irradiance table: r texels")
+            .ShapesTables()
+            .Integer("scattering-r", &C::scattering_r, 2, 1024, "", "scattering table: r texels")
+            .ShapesTables()
+            .Integer("scattering-mu", &C::scattering_mu, 4, 4096, "",
+                     "scattering table: mu texels (even)")
+            .ShapesTables()
+            .Integer("scattering-mu-s", &C::scattering_mu_s, 2, 1024, "",
+                     "scattering table: mu_s texels")
+            .ShapesTables()
+            .Integer("scattering-nu", &C::scattering_nu, 2, 1024, "", "scattering table: nu texels")
+            .ShapesTables()
+            .Validate([](const std::string& model, const C& c, const std::set<std::string>&) {
+                if (c.scattering_mu % 2 != 0) {
+                    Fail("model ", model,
+                         ": option scattering-mu must be even (half of the "
+                         "table is for rays that hit the ground), got ",
+                         c.scattering_mu);
+                }
+            });
+    return table;
 }
+
+BrunetonModel::BrunetonModel(const BrunetonConfig& options)
+    : info_(StaticInfo()), config_(options), atm_(EarthAtmosphere()) {}
 
 void BrunetonModel::Prepare(const AtmosphereParameters& atmosphere) {
     atm_ = atmosphere;
@@ -93,22 +98,6 @@ BrunetonEvaluator BrunetonModel::MakeEvaluator() const {
 }
 
 namespace {
-
-nlohmann::ordered_json ConfigJson(const BrunetonConfig& c) {
-    nlohmann::ordered_json j;
-    j["orders"] = c.orders;
-    j["scattering_samples"] = c.scattering_samples;
-    j["mie_storage"] = c.combined_mie ? "combined" : "separate";
-    j["transmittance_width"] = c.transmittance_width;
-    j["transmittance_height"] = c.transmittance_height;
-    j["irradiance_width"] = c.irradiance_width;
-    j["irradiance_height"] = c.irradiance_height;
-    j["scattering_r_size"] = c.scattering_r;
-    j["scattering_mu_size"] = c.scattering_mu;
-    j["scattering_mu_s_size"] = c.scattering_mu_s;
-    j["scattering_nu_size"] = c.scattering_nu;
-    return j;
-}
 
 std::string ReadText(const std::string& path) {
     std::ifstream in(path);
@@ -139,7 +128,7 @@ void BrunetonModel::Bake(const std::string& directory) const {
         "Bruneton 2017 precomputed atmospheric scattering tables (seed 004 mappings), float32, "
         "per unit solar irradiance (multiply radiance and irradiance by solar_irradiance). Each "
         "table is one EXR of W*D x H pixels: the D layers side by side.";
-    j["options"] = ConfigJson(config_);
+    j["options"] = OptionsJson(OptionRows().Specs(), OptionRows().Values(config_));
     nlohmann::ordered_json tables;
     tables["transmittance"] = {
         {"file", "transmittance.exr"},
@@ -210,15 +199,8 @@ void BrunetonModel::LoadBaked(const std::string& directory,
             Fail("'", path, "' has format_version ", j.at("format_version").get<int>(),
                  ", expected ", kBakeFormatVersion);
         }
-        const nlohmann::ordered_json want = ConfigJson(config_);
-        const nlohmann::ordered_json& have = j.at("options");
-        for (auto it = want.begin(); it != want.end(); ++it) {
-            if (!have.contains(it.key()) || have.at(it.key()) != it.value()) {
-                Fail("'", path, "' was baked with ", it.key(), " = ",
-                     have.contains(it.key()) ? have.at(it.key()).dump() : "(missing)",
-                     ", but the model has ", it.value().dump());
-            }
-        }
+        CheckBakedOptions(path, j.at("options"), OptionRows().Specs(),
+                          OptionRows().Values(config_));
         const AtmosphereParameters baked =
             AtmosphereFromJson(j.at("atmosphere").dump(), path + ": atmosphere");
         if (AtmosphereToJson(baked) != AtmosphereToJson(atmosphere)) {

@@ -528,7 +528,9 @@ BrunetonLut MakeBrunetonLut(const AtmosphereParameters& atmosphere, const Brunet
 
 class BrunetonModel : public EvaluatorModel<BrunetonModel> {
   public:
-    explicit BrunetonModel(const ModelOptions& options);
+    using Options = BrunetonConfig;
+    static const OptionTable<BrunetonConfig>& OptionRows();
+    explicit BrunetonModel(const BrunetonConfig& options);
     static ModelInfo StaticInfo();
     const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override;

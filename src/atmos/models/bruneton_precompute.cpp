@@ -32,8 +32,6 @@ struct Stopwatch {
     }
 };
 
-constexpr int kMaxScatteringSamples = 1000;  // seed 004 uses 50 (the default)
-
 // Rows of the 3D scattering table: one (mu, r) pair = (y, z), NU * MU_S texels.
 int RowCount(const BrunetonConfig& c) { return c.scattering_mu * c.scattering_r; }
 
@@ -51,23 +49,7 @@ int64_t TexelCount(const Table& t) {
 }  // namespace
 
 void ValidateBrunetonConfig(const BrunetonConfig& c) {
-    auto check = [](const char* name, int v, int lo, int hi) {
-        if (v < lo || v > hi) Fail("bruneton: --", name, " ", v, " outside [", lo, ", ", hi, "]");
-    };
-    check("transmittance-width", c.transmittance_width, 2, 4096);
-    check("transmittance-height", c.transmittance_height, 2, 4096);
-    check("irradiance-width", c.irradiance_width, 2, 4096);
-    check("irradiance-height", c.irradiance_height, 2, 4096);
-    check("scattering-r", c.scattering_r, 2, 1024);
-    check("scattering-mu", c.scattering_mu, 4, 4096);
-    check("scattering-mu-s", c.scattering_mu_s, 2, 1024);
-    check("scattering-nu", c.scattering_nu, 2, 1024);
-    check("orders", c.orders, 1, 32);
-    check("scattering-samples", c.scattering_samples, 1, kMaxScatteringSamples);
-    if (c.scattering_mu % 2 != 0) {
-        Fail("bruneton: --scattering-mu ", c.scattering_mu,
-             " must be even (half of the table is for rays that hit the ground)");
-    }
+    BrunetonModel::OptionRows().Check("bruneton", c);
 }
 
 BrunetonLut MakeBrunetonLut(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,

@@ -22,7 +22,9 @@ struct EmptyEvaluator {
 
 class EmptyModel : public SimpleEvaluatorModel<EmptyModel, EmptyEvaluator> {
   public:
-    explicit EmptyModel(const ModelOptions&) {}
+    using Options = NoOptions;
+    static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
+    explicit EmptyModel(const NoOptions&) {}
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override { atm_ = atmosphere; }
 };

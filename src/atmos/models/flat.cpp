@@ -15,7 +15,7 @@ ModelInfo FlatModel::StaticInfo() {
     return info;
 }
 
-FlatModel::FlatModel(const ModelOptions&) { Prepare(EarthAtmosphere()); }
+FlatModel::FlatModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
 
 void FlatModel::Prepare(const AtmosphereParameters& atmosphere) {
     atm_ = atmosphere;

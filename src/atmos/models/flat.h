@@ -124,7 +124,9 @@ struct FlatEvaluator {
 
 class FlatModel : public SimpleEvaluatorModel<FlatModel, FlatEvaluator> {
   public:
-    explicit FlatModel(const ModelOptions& options);
+    using Options = NoOptions;
+    static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
+    explicit FlatModel(const NoOptions& options);
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override;
 };

@@ -16,6 +16,7 @@
 #include "base/parallel.h"
 #include "io/table_io.h"
 #include "models/hillaire_stages.h"
+#include "models/option_json.h"
 #include "render/stages.h"
 
 namespace atmos {
@@ -48,74 +49,48 @@ ModelInfo HillaireModel::StaticInfo() {
         "tables inside the atmosphere, ray march outside";
     info.capabilities.multiple_scattering = true;
     info.capabilities.precomputed = true;
-    using T = ModelOptionSpec::Type;
-    info.options = {
-        {"steps",
-         T::kInteger,
-         "40",
-         "ray-march steps for cameras outside the atmosphere",
-         1,
-         1e5,
-         {}},
-        {"sky-view-steps", T::kInteger, "30", "ray-march steps of each sky-view texel", 1, 1e5, {}},
-        {"transmittance-steps",
-         T::kInteger,
-         "40",
-         "optical-depth steps of the transmittance table",
-         1,
-         1e5,
-         {}},
-        {"ap-km-per-slice",
-         T::kReal,
-         "4",
-         "aerial-perspective depth scale (km per slice)",
-         0.001,
-         1e4,
-         {}},
-        {"ap-steps-per-slice",
-         T::kInteger,
-         "4",
-         "aerial-perspective march segments per slice",
-         1,
-         1e4,
-         {}},
-        {"segment-offset",
-         T::kReal,
-         "0.3",
-         "position of the sample inside each march segment (0.3: the paper's demo, 0.5: "
-         "midpoint)",
-         0,
-         1,
-         {}},
-        {"ground-path",
-         T::kChoice,
-         "aerial-perspective",
-         "in-scatter and transmittance of ground rays (camera inside): from the aerial-"
-         "perspective volume or the sky-view table",
-         0,
-         0,
-         {"aerial-perspective", "sky-view"}},
-        {"sample-path",
-         T::kChoice,
-         "table",
-         "sample: sky-view table per (altitude, sun) group, or ray march everything",
-         0,
-         0,
-         {"table", "march"}},
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-HillaireModel::HillaireModel(const ModelOptions& options) : info_(StaticInfo()) {
+const OptionTable<HillaireOptions>& HillaireModel::OptionRows() {
+    using O = HillaireOptions;
+    static const auto table =
+        OptionTable<O>()
+            .Integer("steps", &O::steps, 1, 1e5, "",
+                     "ray-march steps for cameras outside the atmosphere")
+            .Integer("sky-view-steps", &O::sky_view_steps, 1, 1e5, "",
+                     "ray-march steps of each sky-view texel")
+            .Integer("transmittance-steps", &O::transmittance_steps, 1, 1e5, "",
+                     "optical-depth steps of the transmittance table")
+            .ShapesTables()
+            .Real("ap-km-per-slice", &O::ap_km_per_slice, 0.001, 1e4, "km",
+                  "aerial-perspective depth scale (km per slice)")
+            .Integer("ap-steps-per-slice", &O::ap_steps_per_slice, 1, 1e4, "",
+                     "aerial-perspective march segments per slice")
+            .Real("segment-offset", &O::segment_offset, 0, 1, "",
+                  "position of the sample inside each march segment (0.3: the paper's demo, 0.5: "
+                  "midpoint)")
+            .Choice("ground-path", &O::ground_from_ap,
+                    {{"aerial-perspective", true}, {"sky-view", false}},
+                    "in-scatter and transmittance of ground rays (camera inside): from the aerial-"
+                    "perspective volume or the sky-view table")
+            .Choice("sample-path", &O::sample_with_tables, {{"table", true}, {"march", false}},
+                    "sample: sky-view table per (altitude, sun) group, or ray march everything");
+    return table;
+}
+
+HillaireModel::HillaireModel(const HillaireOptions& options) : info_(StaticInfo()) {
     evaluator_.atm = EarthAtmosphere();
-    evaluator_.steps = options.GetInt("steps");
-    sky_view_steps_ = options.GetInt("sky-view-steps");
-    transmittance_steps_ = options.GetInt("transmittance-steps");
-    evaluator_.ap_metres_per_slice = options.GetReal("ap-km-per-slice") * 1000.0;
-    ap_steps_per_slice_ = options.GetInt("ap-steps-per-slice");
-    evaluator_.segment_offset = options.GetReal("segment-offset");
-    evaluator_.ground_from_ap = options.GetText("ground-path") == "aerial-perspective";
-    sample_with_tables_ = options.GetText("sample-path") == "table";
+    evaluator_.steps = options.steps;
+    sky_view_steps_ = options.sky_view_steps;
+    transmittance_steps_ = options.transmittance_steps;
+    evaluator_.ap_metres_per_slice = options.ap_km_per_slice * 1000.0;
+    ap_steps_per_slice_ = options.ap_steps_per_slice;
+    evaluator_.segment_offset = options.segment_offset;
+    evaluator_.ground_from_ap = options.ground_from_ap;
+    sample_with_tables_ = options.sample_with_tables;
+    options_ = options;
 }
 
 void HillaireModel::Attach() {
@@ -292,7 +267,9 @@ void HillaireModel::Bake(const std::string& directory) const {
     nlohmann::json j;
     j["model"] = "hillaire";
     j["source"] = info_.citation;
-    j["transmittance_steps"] = transmittance_steps_;
+    j["format_version"] = 2;  // 2: "options" from the option table
+    j["options"] = nlohmann::json::parse(
+        OptionsJson(OptionRows().Specs(), OptionRows().Values(options_)).dump());
     j["tables"] = nlohmann::json::array(
         {{{"name", "transmittance"},
           {"file", kTransmittanceExr},
@@ -342,9 +319,13 @@ void HillaireModel::LoadBaked(const std::string& directory,
         j["atmosphere"] != nlohmann::json::parse(AtmosphereToJson(atmosphere))) {
         Fail(json_path.string(), ": the baked atmosphere differs from the requested one");
     }
-    if (!j.contains("transmittance_steps") || j["transmittance_steps"] != transmittance_steps_) {
-        Fail(json_path.string(), ": baked with a different --transmittance-steps");
+    if (!j.contains("format_version") || j["format_version"] != 2) {
+        Fail(json_path.string(), ": baked by another version of atmos (format_version ",
+             j.contains("format_version") ? j["format_version"].dump() : "missing",
+             ", expected 2): bake it again");
     }
+    CheckBakedOptions(json_path.string(), nlohmann::ordered_json::parse(j["options"].dump()),
+                      OptionRows().Specs(), OptionRows().Values(options_));
     ValidateAtmosphere(atmosphere);
     evaluator_.atm = atmosphere;
     Table t = ReadTableExr((fs::path(directory) / kTransmittanceExr).string(), 1, 3);

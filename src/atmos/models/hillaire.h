@@ -426,9 +426,22 @@ class HillaireFrame {
     Table sky_view, ap_scatter, ap_transmittance;  // empty when not built
 };
 
+struct HillaireOptions {
+    int steps = 40;                // ray-march steps for cameras outside the atmosphere
+    int sky_view_steps = 30;       // per sky-view texel
+    int transmittance_steps = 40;  // of the transmittance table
+    double ap_km_per_slice = 4.0;  // aerial-perspective depth scale
+    int ap_steps_per_slice = 4;
+    double segment_offset = 0.3;     // sample position inside a march segment (demo: 0.3)
+    bool ground_from_ap = true;      // ground rays from the aerial-perspective volume
+    bool sample_with_tables = true;  // sample through sky-view tables (false: march)
+};
+
 class HillaireModel : public Model {
   public:
-    explicit HillaireModel(const ModelOptions& options);
+    using Options = HillaireOptions;
+    static const OptionTable<HillaireOptions>& OptionRows();
+    explicit HillaireModel(const HillaireOptions& options);
     static ModelInfo StaticInfo();
     const ModelInfo& Info() const override { return info_; }
     // Builds the transmittance and multiple-scattering tables (timed).
@@ -472,6 +485,7 @@ class HillaireModel : public Model {
     HillaireEvaluator StageEvaluator() const;
 
     ModelInfo info_;
+    HillaireOptions options_;
     HillaireEvaluator evaluator_;
     int transmittance_steps_ = 40;
     int sky_view_steps_ = 30;

@@ -1,6 +1,7 @@
 // atmos: option validation and small helpers of the model interface.
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -19,6 +20,82 @@ const char* QuantityName(Quantity q) {
     return q == Quantity::kRadiance ? "radiance" : "transmittance";
 }
 
+std::string FormatOptionNumber(double value) {
+    char buf[40];
+    if (value == std::floor(value) && std::fabs(value) < 1e15) {
+        std::snprintf(buf, sizeof buf, "%.0f", value);
+        return buf;
+    }
+    for (int precision = 1; precision <= 17; ++precision) {
+        std::snprintf(buf, sizeof buf, "%.*g", precision, value);
+        if (std::strtod(buf, nullptr) == value) break;
+    }
+    return buf;
+}
+
+const char* ModelOptionSpec::TypeName() const {
+    switch (type) {
+        case Type::kInteger:
+            return "integer";
+        case Type::kReal:
+            return "real";
+        case Type::kChoice:
+            return "choice";
+        case Type::kText:
+            return "text";
+    }
+    return "?";
+}
+
+std::string ModelOptionSpec::Describe() const {
+    auto range = [&] {
+        return "[" + FormatOptionNumber(min) + ", " + FormatOptionNumber(max) + "]";
+    };
+    switch (type) {
+        case Type::kInteger:
+            return "an integer in " + range();
+        case Type::kReal:
+            return "a number in " + range() + (unit.empty() ? "" : " " + unit);
+        case Type::kChoice: {
+            std::string list;
+            for (const std::string& c : choices) list += (list.empty() ? "" : ", ") + c;
+            return "one of " + list;
+        }
+        case Type::kText:
+            return "a non-empty text";
+    }
+    return "?";
+}
+
+std::string OptionsMarkdown(const std::vector<ModelOptionSpec>& specs) {
+    if (specs.empty()) return "This model has no options.\n";
+    std::string md = "| option | type | default | range | help |\n|---|---|---|---|---|\n";
+    for (const ModelOptionSpec& s : specs) {
+        std::string range;
+        switch (s.type) {
+            case ModelOptionSpec::Type::kInteger:
+            case ModelOptionSpec::Type::kReal:
+                range = "[" + FormatOptionNumber(s.min) + ", " + FormatOptionNumber(s.max) + "]" +
+                        (s.unit.empty() ? "" : " " + s.unit);
+                break;
+            case ModelOptionSpec::Type::kChoice:
+                for (const std::string& c : s.choices) range += (range.empty() ? "" : ", ") + c;
+                break;
+            case ModelOptionSpec::Type::kText:
+                range = "non-empty text";
+                break;
+        }
+        std::string help = s.help;
+        if (s.shapes_tables) help += " (shapes the baked tables)";
+        std::string escaped;
+        for (char c : help) escaped += c == '|' ? std::string("\\|") : std::string(1, c);
+        md += "| `" + s.name + "` | " + s.TypeName() + " | " +
+              (s.default_value.empty() ? std::string("(none)") : "`" + s.default_value + "`") +
+              " | " + range + " | " + escaped + " |\n";
+    }
+    return md;
+}
+
 namespace {
 
 bool ParseDouble(const std::string& text, double* value) {
@@ -29,62 +106,80 @@ bool ParseDouble(const std::string& text, double* value) {
     return errno == 0 && end == text.c_str() + text.size() && std::isfinite(*value);
 }
 
-void CheckValue(const std::string& model, const ModelOptionSpec& spec, const std::string& text) {
-    const std::string where = "option --" + spec.name + " of model " + model;
-    switch (spec.type) {
-        case ModelOptionSpec::Type::kInteger: {
-            double v = 0.0;
-            if (!ParseDouble(text, &v) || v != std::floor(v) || v < spec.min || v > spec.max) {
-                Fail(where, " must be an integer in [", spec.min, ", ", spec.max, "], got '", text,
-                     "'");
-            }
-            break;
-        }
-        case ModelOptionSpec::Type::kReal: {
-            double v = 0.0;
-            if (!ParseDouble(text, &v) || v < spec.min || v > spec.max) {
-                Fail(where, " must be a number in [", spec.min, ", ", spec.max, "], got '", text,
-                     "'");
-            }
-            break;
-        }
-        case ModelOptionSpec::Type::kChoice: {
-            std::string list;
-            for (const std::string& c : spec.choices) {
-                if (c == text) return;
-                list += (list.empty() ? "" : ", ") + c;
-            }
-            Fail(where, " must be one of ", list, ", got '", text, "'");
-        }
-        case ModelOptionSpec::Type::kText:
-            if (text.empty()) Fail(where, " must not be empty");
-            break;
-    }
+[[noreturn]] void FailValue(const std::string& model, const ModelOptionSpec& spec,
+                            const std::string& text) {
+    Fail("model ", model, ": option ", spec.name, " must be ", spec.Describe(), ", got '", text,
+         "'");
 }
 
 }  // namespace
 
-ModelOptions::ModelOptions(const std::string& model_name, const std::vector<ModelOptionSpec>& specs,
-                           const std::map<std::string, std::string>& given) {
-    for (const ModelOptionSpec& spec : specs) values_[spec.name] = spec.default_value;
-    for (const auto& [name, text] : given) {
-        bool known = false;
-        for (const ModelOptionSpec& spec : specs) {
-            if (spec.name != name) continue;
-            known = true;
-            CheckValue(model_name, spec, text);
-        }
-        if (!known) {
-            std::string list;
-            for (const ModelOptionSpec& spec : specs)
-                list += (list.empty() ? "--" : ", --") + spec.name;
-            Fail("model ", model_name, " has no option --", name,
-                 list.empty() ? std::string(" (it takes no options)")
-                              : " (its options: " + list + ")");
-        }
-        values_[name] = text;
-        set_[name] = true;
+namespace detail {
+
+double ParseNumberOption(const std::string& model, const ModelOptionSpec& spec,
+                         const std::string& text) {
+    double v = 0.0;
+    const bool integer = spec.type == ModelOptionSpec::Type::kInteger;
+    if (!ParseDouble(text, &v) || (integer && v != std::floor(v)) || v < spec.min || v > spec.max) {
+        FailValue(model, spec, text);
     }
+    return v;
+}
+
+size_t ParseChoiceOption(const std::string& model, const ModelOptionSpec& spec,
+                         const std::string& text) {
+    for (size_t i = 0; i < spec.choices.size(); ++i) {
+        if (spec.choices[i] == text) return i;
+    }
+    FailValue(model, spec, text);
+}
+
+void CheckTextOption(const std::string& model, const ModelOptionSpec& spec,
+                     const std::string& text) {
+    if (text.empty()) FailValue(model, spec, text);
+}
+
+void FailUnknownOption(const std::string& model, const std::vector<ModelOptionSpec>& specs,
+                       const std::string& name) {
+    std::string list;
+    for (const ModelOptionSpec& spec : specs) list += (list.empty() ? "" : ", ") + spec.name;
+    Fail("model ", model, " has no option '", name, "'",
+         list.empty() ? std::string(" (it takes no options)") : " (its options: " + list + ")",
+         "; `atmos list ", model, "` prints them");
+}
+
+}  // namespace detail
+
+const OptionTable<NoOptions>& NoOptionTable() {
+    static const OptionTable<NoOptions> table;
+    return table;
+}
+
+ModelSpec ParseModelSpec(const std::string& text) {
+    ModelSpec spec;
+    spec.text = text;
+    size_t at = text.find(':');
+    spec.name = GetModelInfo(text.substr(0, at)).name;
+    while (at != std::string::npos) {
+        const size_t next = text.find(':', at + 1);
+        const std::string item =
+            text.substr(at + 1, next == std::string::npos ? next : next - at - 1);
+        const size_t eq = item.find('=');
+        if (eq == std::string::npos || eq == 0) {
+            Fail("model '", text, "': expected NAME:OPTION=VALUE[:OPTION=VALUE...], got '", item,
+                 "'");
+        }
+        if (!spec.options.emplace(item.substr(0, eq), item.substr(eq + 1)).second) {
+            Fail("model '", text, "': option '", item.substr(0, eq), "' given twice");
+        }
+        at = next;
+    }
+    ResolveModelOptions(spec.name, spec.options);  // validates names and values
+    return spec;
+}
+
+std::unique_ptr<Model> CreateModel(const ModelSpec& spec) {
+    return CreateModel(spec.name, spec.options);
 }
 
 void Model::Bake(const std::string&) const {
@@ -93,22 +188,6 @@ void Model::Bake(const std::string&) const {
 
 void Model::LoadBaked(const std::string&, const AtmosphereParameters&) {
     Fail("model ", Info().name, " has no precomputed tables to load");
-}
-
-int ModelOptions::GetInt(const std::string& name) const {
-    return static_cast<int>(std::lround(GetReal(name)));
-}
-
-double ModelOptions::GetReal(const std::string& name) const {
-    double v = 0.0;
-    if (!ParseDouble(GetText(name), &v)) Fail("option --", name, " is not a number");
-    return v;
-}
-
-const std::string& ModelOptions::GetText(const std::string& name) const {
-    auto it = values_.find(name);
-    if (it == values_.end()) Fail("internal: no option --", name);
-    return it->second;
 }
 
 }  // namespace atmos

@@ -10,29 +10,23 @@ ModelInfo NaiveModel::StaticInfo() {
         "Nishita et al. 1993; Terrell 2016 (glsl-atmosphere); seed 003 sections 3.2, 5.1, 11.2.6";
     info.summary = "single scattering by nested numerical integration, Rayleigh + Mie + ozone";
     info.capabilities.multiple_scattering = false;
-    info.options = {
-        {"steps",
-         ModelOptionSpec::Type::kInteger,
-         "16",
-         "view-ray integration samples",
-         1,
-         1e5,
-         {}},
-        {"light-steps",
-         ModelOptionSpec::Type::kInteger,
-         "8",
-         "light-ray integration samples",
-         1,
-         1e5,
-         {}},
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-NaiveModel::NaiveModel(const ModelOptions& options) {
+const OptionTable<NaiveOptions>& NaiveModel::OptionRows() {
+    static const auto table =
+        OptionTable<NaiveOptions>()
+            .Integer("steps", &NaiveOptions::steps, 1, 1e5, "", "view-ray integration samples")
+            .Integer("light-steps", &NaiveOptions::light_steps, 1, 1e5, "",
+                     "light-ray integration samples");
+    return table;
+}
+
+NaiveModel::NaiveModel(const NaiveOptions& options) {
     evaluator_.atm = EarthAtmosphere();
-    evaluator_.steps = options.GetInt("steps");
-    evaluator_.light_steps = options.GetInt("light-steps");
+    evaluator_.steps = options.steps;
+    evaluator_.light_steps = options.light_steps;
 }
 
 }  // namespace atmos

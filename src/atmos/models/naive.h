@@ -74,9 +74,16 @@ struct NaiveEvaluator {
     }
 };
 
+struct NaiveOptions {
+    int steps = 16;       // view-ray samples
+    int light_steps = 8;  // light-ray samples
+};
+
 class NaiveModel : public SimpleEvaluatorModel<NaiveModel, NaiveEvaluator> {
   public:
-    explicit NaiveModel(const ModelOptions& options);
+    using Options = NaiveOptions;
+    static const OptionTable<NaiveOptions>& OptionRows();
+    explicit NaiveModel(const NaiveOptions& options);
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override {
         atm_ = atmosphere;

@@ -283,28 +283,24 @@ ModelInfo NeuralModel::StaticInfo() {
         "MLPs for transmittance (2-4-3) and scattering (4-8-8-3), fitted with `atmos fit`";
     info.capabilities.multiple_scattering = true;
     info.capabilities.precomputed = true;
-    info.options = {
-        {"network",
-         ModelOptionSpec::Type::kChoice,
-         "thesis",
-         "shipped weights: thesis (4-8-8-3) or large (7-32-32-3, extended inputs)",
-         0,
-         0,
-         {"thesis", "large"}},
-        {"weights",
-         ModelOptionSpec::Type::kText,
-         "",
-         "weights JSON written by `atmos fit` (default: the shipped ones for earth)",
-         0,
-         0,
-         {}},
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-NeuralModel::NeuralModel(const ModelOptions& options) {
-    weights_path_ = options.GetText("weights");
-    network_ = options.GetText("network");
+const OptionTable<NeuralOptions>& NeuralModel::OptionRows() {
+    static const auto table =
+        OptionTable<NeuralOptions>()
+            .Choice("network", &NeuralOptions::network,
+                    {{"thesis", std::string("thesis")}, {"large", std::string("large")}},
+                    "shipped weights: thesis (4-8-8-3) or large (7-32-32-3, extended inputs)")
+            .Text("weights", &NeuralOptions::weights,
+                  "weights JSON written by `atmos fit` (default: the shipped ones for earth)");
+    return table;
+}
+
+NeuralModel::NeuralModel(const NeuralOptions& options) {
+    weights_path_ = options.weights;
+    network_ = options.network;
 }
 
 void NeuralModel::Prepare(const AtmosphereParameters& atmosphere) {

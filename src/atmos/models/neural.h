@@ -147,9 +147,16 @@ void CheckNeuralWeightsMatch(const NeuralWeights& weights, const AtmosphereParam
 NeuralEvaluator MakeNeuralEvaluator(const NeuralWeights& weights,
                                     const AtmosphereParameters& atmosphere);
 
+struct NeuralOptions {
+    std::string network = "thesis";  // shipped weights: thesis | large
+    std::string weights;             // weights JSON of `atmos fit` (empty: the shipped ones)
+};
+
 class NeuralModel : public SimpleEvaluatorModel<NeuralModel, NeuralEvaluator> {
   public:
-    explicit NeuralModel(const ModelOptions& options);
+    using Options = NeuralOptions;
+    static const OptionTable<NeuralOptions>& OptionRows();
+    explicit NeuralModel(const NeuralOptions& options);
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override;
 

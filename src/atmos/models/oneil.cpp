@@ -32,29 +32,23 @@ ModelInfo OneilModel::StaticInfo() {
         "single scattering, midpoint rule with the fitted scale() optical depth; scale() "
         "refitted per atmosphere in Prepare(); no ozone";
     info.capabilities.precomputed = true;
-    info.options = {
-        {"steps",
-         ModelOptionSpec::Type::kInteger,
-         "5",
-         "view-ray samples (his nSamples)",
-         1,
-         1e5,
-         {}},
-        {"fit",
-         ModelOptionSpec::Type::kChoice,
-         "refit",
-         "scale() constants: refit (least squares per medium) or original (O'Neil's, scale "
-         "depth 0.25)",
-         0,
-         0,
-         {"refit", "original"}},
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-OneilModel::OneilModel(const ModelOptions& options) {
-    evaluator_.steps = options.GetInt("steps");
-    refit_ = options.GetText("fit") == "refit";
+const OptionTable<OneilOptions>& OneilModel::OptionRows() {
+    static const auto table =
+        OptionTable<OneilOptions>()
+            .Integer("steps", &OneilOptions::steps, 1, 1e5, "", "view-ray samples (his nSamples)")
+            .Choice("fit", &OneilOptions::refit, {{"refit", true}, {"original", false}},
+                    "scale() constants: refit (least squares per medium) or original (O'Neil's, "
+                    "scale depth 0.25)");
+    return table;
+}
+
+OneilModel::OneilModel(const OneilOptions& options) {
+    evaluator_.steps = options.steps;
+    refit_ = options.refit;
     Prepare(EarthAtmosphere());
 }
 

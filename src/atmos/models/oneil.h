@@ -143,9 +143,16 @@ struct OneilEvaluator {
 // (physics/analytic_fit.h); otherwise his constants with scale depth 0.25.
 OneilOptics MakeOneilOptics(const AtmosphereParameters& atmosphere, bool refit);
 
+struct OneilOptions {
+    int steps = 5;      // view-ray samples
+    bool refit = true;  // scale() refitted per medium (false: O'Neil's constants)
+};
+
 class OneilModel : public SimpleEvaluatorModel<OneilModel, OneilEvaluator> {
   public:
-    explicit OneilModel(const ModelOptions& options);
+    using Options = OneilOptions;
+    static const OptionTable<OneilOptions>& OptionRows();
+    explicit OneilModel(const OneilOptions& options);
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override;
 

@@ -32,20 +32,18 @@ ModelInfo PreethamModel::StaticInfo() {
     info.capabilities.space_views = false;
     info.capabilities.sun_below_horizon = false;
     info.capabilities.multiple_scattering = true;  // fitted to a full simulation
-    info.options = {
-        {"turbidity",
-         ModelOptionSpec::Type::kReal,
-         "2.5",
-         "atmospheric turbidity T",
-         1.7,
-         10.0,
-         {}},
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-PreethamModel::PreethamModel(const ModelOptions& options) {
-    const double T = options.GetReal("turbidity");
+const OptionTable<PreethamOptions>& PreethamModel::OptionRows() {
+    static const auto table = OptionTable<PreethamOptions>().Real(
+        "turbidity", &PreethamOptions::turbidity, 1.7, 10.0, "", "atmospheric turbidity T");
+    return table;
+}
+
+PreethamModel::PreethamModel(const PreethamOptions& options) {
+    const double T = options.turbidity;
     evaluator_.turbidity = T;
     evaluator_.kY = PreethamLuminanceCoefficients(T);
     evaluator_.kx = PreethamXCoefficients(T);

@@ -146,9 +146,15 @@ struct PreethamEvaluator {
     }
 };
 
+struct PreethamOptions {
+    double turbidity = 2.5;  // atmospheric turbidity T (Preetham's fit: [1.7, 10])
+};
+
 class PreethamModel : public SimpleEvaluatorModel<PreethamModel, PreethamEvaluator> {
   public:
-    explicit PreethamModel(const ModelOptions& options);
+    using Options = PreethamOptions;
+    static const OptionTable<PreethamOptions>& OptionRows();
+    explicit PreethamModel(const PreethamOptions& options);
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override;
 };

@@ -10,14 +10,18 @@ ModelInfo RaymarchedModel::StaticInfo() {
     info.summary =
         "single scattering summed over a few closed-form segments (Eq. 55), flat optical "
         "depth, ozone shell";
-    info.options = {
-        {"steps", ModelOptionSpec::Type::kInteger, "5", "view-ray segments", 1, 1e5, {}},
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-RaymarchedModel::RaymarchedModel(const ModelOptions& options) {
-    evaluator_.steps = options.GetInt("steps");
+const OptionTable<RaymarchedOptions>& RaymarchedModel::OptionRows() {
+    static const auto table = OptionTable<RaymarchedOptions>().Integer(
+        "steps", &RaymarchedOptions::steps, 1, 1e5, "", "view-ray segments");
+    return table;
+}
+
+RaymarchedModel::RaymarchedModel(const RaymarchedOptions& options) {
+    evaluator_.steps = options.steps;
     Prepare(EarthAtmosphere());
 }
 

@@ -67,9 +67,15 @@ struct RaymarchedEvaluator {
     }
 };
 
+struct RaymarchedOptions {
+    int steps = 5;  // view-ray segments
+};
+
 class RaymarchedModel : public SimpleEvaluatorModel<RaymarchedModel, RaymarchedEvaluator> {
   public:
-    explicit RaymarchedModel(const ModelOptions& options);
+    using Options = RaymarchedOptions;
+    static const OptionTable<RaymarchedOptions>& OptionRows();
+    explicit RaymarchedModel(const RaymarchedOptions& options);
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override;
 };

@@ -80,61 +80,42 @@ ModelInfo ReferenceModel::StaticInfo() {
     info.summary = "unbiased Monte Carlo: all scattering orders, planet shadow, Lambertian ground";
     info.capabilities.multiple_scattering = true;
     info.capabilities.stochastic = true;
-    using T = ModelOptionSpec::Type;
-    info.options = {
-        {"sun-disc-light",
-         T::kInteger,
-         "0",
-         "1: light from the sun's disc (angular radius from the atmosphere), sampled per "
-         "next-event estimate; 0: a directional sun like the other models",
-         0,
-         1,
-         {}},
-        {"estimator",
-         T::kChoice,
-         "spectral",
-         "spectral: all channels per path (spectral tracking, forced first collision, "
-         "ratio-tracked sun); thesis: the thesis's estimator (one random channel per path, "
-         "delta tracking, uniform directions), kept as a baseline",
-         0,
-         0,
-         {"spectral", "thesis"}},
-        {"spp", T::kInteger, "64", "paths per pixel (per query for sample)", 1, 1e9, {}},
-        {"seed", T::kInteger, "0", "random seed", 0, 4294967295.0, {}},
-        {"max-order",
-         T::kInteger,
-         "0",
-         "highest scattering order (volume or ground vertices); 0: unlimited",
-         0,
-         1e6,
-         {}},
-        {"shells",
-         T::kInteger,
-         "48",
-         "altitude shells of the majorant (1: one global majorant)",
-         1,
-         kMaxReferenceShells,
-         {}},
-        {"pass-spp",
-         T::kInteger,
-         "0",
-         "paths per pixel per pass (checkpoint and variance granularity); 0: spp/8 in [1, 64]. "
-         "Set it explicitly to extend a checkpointed render to more spp with --resume",
-         0,
-         1e9,
-         {}},
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-ReferenceModel::ReferenceModel(const ModelOptions& options) : info_(StaticInfo()) {
-    spp_ = options.GetInt("spp");
-    pass_spp_ = options.GetInt("pass-spp");
-    shell_count_ = options.GetInt("shells");
-    evaluator_.seed = static_cast<uint64_t>(options.GetReal("seed"));
-    evaluator_.max_order = options.GetInt("max-order");
-    evaluator_.spectral = options.GetText("estimator") == "spectral";
-    sun_disc_light_ = options.GetInt("sun-disc-light") != 0;
+const OptionTable<ReferenceOptions>& ReferenceModel::OptionRows() {
+    using O = ReferenceOptions;
+    static const auto table =
+        OptionTable<O>()
+            .Integer("sun-disc-light", &O::sun_disc_light, 0, 1, "",
+                     "1: light from the sun's disc (angular radius from the atmosphere), sampled "
+                     "per next-event estimate; 0: a directional sun like the other models")
+            .Choice("estimator", &O::spectral, {{"spectral", true}, {"thesis", false}},
+                    "spectral: all channels per path (spectral tracking, forced first collision, "
+                    "ratio-tracked sun); thesis: the thesis's estimator (one random channel per "
+                    "path, delta tracking, uniform directions), kept as a baseline")
+            .Integer("spp", &O::spp, 1, 1e9, "", "paths per pixel (per query for sample)")
+            .Integer("seed", &O::seed, 0, 4294967295.0, "", "random seed")
+            .Integer("max-order", &O::max_order, 0, 1e6, "",
+                     "highest scattering order (volume or ground vertices); 0: unlimited")
+            .Integer("shells", &O::shells, 1, kMaxReferenceShells, "",
+                     "altitude shells of the majorant (1: one global majorant)")
+            .Integer("pass-spp", &O::pass_spp, 0, 1e9, "",
+                     "paths per pixel per pass (checkpoint and variance granularity); 0: spp/8 "
+                     "in [1, 64]. Set it explicitly to extend a checkpointed render to more spp "
+                     "with --resume");
+    return table;
+}
+
+ReferenceModel::ReferenceModel(const ReferenceOptions& options) : info_(StaticInfo()) {
+    spp_ = options.spp;
+    pass_spp_ = options.pass_spp;
+    shell_count_ = options.shells;
+    evaluator_.seed = options.seed;
+    evaluator_.max_order = options.max_order;
+    evaluator_.spectral = options.spectral;
+    sun_disc_light_ = options.sun_disc_light != 0;
     Prepare(EarthAtmosphere());
 }
 

@@ -463,9 +463,21 @@ struct ReferenceEvaluator {
     }
 };
 
+struct ReferenceOptions {
+    int sun_disc_light = 0;  // 1: light from the sun's disc
+    bool spectral = true;    // estimator: spectral (true) or the thesis's (false)
+    int spp = 64;
+    uint64_t seed = 0;
+    int max_order = 0;  // 0: unlimited
+    int shells = 48;    // altitude shells of the majorant
+    int pass_spp = 0;   // 0: spp/8 in [1, 64]
+};
+
 class ReferenceModel : public Model {
   public:
-    explicit ReferenceModel(const ModelOptions& options);
+    using Options = ReferenceOptions;
+    static const OptionTable<ReferenceOptions>& OptionRows();
+    explicit ReferenceModel(const ReferenceOptions& options);
     static ModelInfo StaticInfo();
     const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override;

@@ -29,15 +29,29 @@ namespace atmos {
 
 namespace {
 
+// Each model M provides `static ModelInfo StaticInfo()`, its options struct
+// (`M::Options`), `static const OptionTable<M::Options>& OptionRows()` and a
+// constructor from M::Options: the registry parses and validates the user's
+// option text through the table, once, and hands the model its typed struct.
 struct Entry {
     std::function<ModelInfo()> info;
-    std::function<std::unique_ptr<Model>(const ModelOptions&)> create;
+    std::function<std::unique_ptr<Model>(const std::string&,
+                                         const std::map<std::string, std::string>&)>
+        create;
+    std::function<std::vector<std::pair<std::string, std::string>>(
+        const std::string&, const std::map<std::string, std::string>&)>
+        resolve;
 };
 
 template <typename M>
 Entry MakeEntry() {
     return {[] { return M::StaticInfo(); },
-            [](const ModelOptions& o) { return std::unique_ptr<Model>(new M(o)); }};
+            [](const std::string& name, const std::map<std::string, std::string>& given) {
+                return std::unique_ptr<Model>(new M(M::OptionRows().Parse(name, given)));
+            },
+            [](const std::string& name, const std::map<std::string, std::string>& given) {
+                return M::OptionRows().Values(M::OptionRows().Parse(name, given));
+            }};
 }
 
 const std::vector<Entry>& Registry() {
@@ -95,14 +109,24 @@ const ModelInfo& GetModelInfo(const std::string& name) {
     Fail("unknown model '", name, "' (models: ", list, ")");
 }
 
-std::unique_ptr<Model> CreateModel(const std::string& name,
-                                   const std::map<std::string, std::string>& options) {
+namespace {
+const Entry& EntryOf(const std::string& name) {
     const ModelInfo& info = GetModelInfo(name);
-    const ModelOptions resolved(info.name, info.options, options);
     for (size_t i = 0; i < Infos().size(); ++i) {
-        if (Infos()[i].name == name) return Registry()[i].create(resolved);
+        if (Infos()[i].name == info.name) return Registry()[i];
     }
     Fail("unknown model '", name, "'");
+}
+}  // namespace
+
+std::unique_ptr<Model> CreateModel(const std::string& name,
+                                   const std::map<std::string, std::string>& options) {
+    return EntryOf(name).create(GetModelInfo(name).name, options);
+}
+
+std::vector<std::pair<std::string, std::string>> ResolveModelOptions(
+    const std::string& name, const std::map<std::string, std::string>& given) {
+    return EntryOf(name).resolve(GetModelInfo(name).name, given);
 }
 
 }  // namespace atmos

@@ -12,22 +12,22 @@ ModelInfo SchulerModel::StaticInfo() {
     info.summary =
         "single scattering, view ray by the midpoint rule, light optical depth by the "
         "Chapman approximation; no ozone";
-    info.options = {
-        {"steps",
-         ModelOptionSpec::Type::kInteger,
-         "16",
-         "view-ray integration samples",
-         1,
-         1e5,
-         {}},
-        ChapmanUnitOption(),
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-SchulerModel::SchulerModel(const ModelOptions& options) {
-    evaluator_.steps = options.GetInt("steps");
-    evaluator_.chapman_unit = ChapmanUnitFromOptions(options);
+const OptionTable<SchulerOptions>& SchulerModel::OptionRows() {
+    static const auto table =
+        OptionTable<SchulerOptions>()
+            .Integer("steps", &SchulerOptions::steps, 1, 1e5, "", "view-ray integration samples")
+            .Choice("chapman-unit", &SchulerOptions::chapman_unit, ChapmanUnitChoices(),
+                    kChapmanUnitHelp);
+    return table;
+}
+
+SchulerModel::SchulerModel(const SchulerOptions& options) {
+    evaluator_.steps = options.steps;
+    evaluator_.chapman_unit = options.chapman_unit;
     Prepare(EarthAtmosphere());
 }
 

@@ -66,9 +66,16 @@ struct SchulerEvaluator {
     }
 };
 
+struct SchulerOptions {
+    int steps = 16;                          // view-ray samples
+    double chapman_unit = kChapmanSeedUnit;  // length unit of the Chapman approximation
+};
+
 class SchulerModel : public SimpleEvaluatorModel<SchulerModel, SchulerEvaluator> {
   public:
-    explicit SchulerModel(const ModelOptions& options);
+    using Options = SchulerOptions;
+    static const OptionTable<SchulerOptions>& OptionRows();
+    explicit SchulerModel(const SchulerOptions& options);
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override;
 };

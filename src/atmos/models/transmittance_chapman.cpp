@@ -9,28 +9,27 @@ ModelInfo TransmittanceChapmanModel::StaticInfo() {
     info.citation = "Schuler 2012 (GPU Pro 3); seed 003 section 5.1 (Eq. 22-25)";
     info.summary = "view-ray transmittance from Schuler's Chapman approximation; no ozone";
     info.capabilities = TransmittanceCapabilities();
-    info.options = {ChapmanUnitOption()};
+    info.options = OptionRows().Specs();
     return info;
 }
 
-ModelOptionSpec ChapmanUnitOption() {
-    return {"chapman-unit",
-            ModelOptionSpec::Type::kChoice,
-            "seed",
-            "length unit of the Chapman approximation: seed (scale height, seed 003 Eq. 25) or "
-            "half-height (H ln 2, Schuler's code)",
-            0,
-            0,
-            {"seed", "half-height"}};
+std::vector<std::pair<std::string, double>> ChapmanUnitChoices() {
+    return {{"seed", kChapmanSeedUnit}, {"half-height", kChapmanHalfHeightUnit}};
 }
 
-double ChapmanUnitFromOptions(const ModelOptions& options) {
-    return options.GetText("chapman-unit") == "half-height" ? kChapmanHalfHeightUnit
-                                                            : kChapmanSeedUnit;
+const char* const kChapmanUnitHelp =
+    "length unit of the Chapman approximation: seed (scale height, seed 003 Eq. 25) or "
+    "half-height (H ln 2, Schuler's code)";
+
+const OptionTable<TransmittanceChapmanOptions>& TransmittanceChapmanModel::OptionRows() {
+    static const auto table = OptionTable<TransmittanceChapmanOptions>().Choice(
+        "chapman-unit", &TransmittanceChapmanOptions::chapman_unit, ChapmanUnitChoices(),
+        kChapmanUnitHelp);
+    return table;
 }
 
-TransmittanceChapmanModel::TransmittanceChapmanModel(const ModelOptions& options) {
-    unit_ = ChapmanUnitFromOptions(options);
+TransmittanceChapmanModel::TransmittanceChapmanModel(const TransmittanceChapmanOptions& options) {
+    unit_ = options.chapman_unit;
     Prepare(EarthAtmosphere());
 }
 

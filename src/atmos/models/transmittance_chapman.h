@@ -39,10 +39,16 @@ struct ChapmanTransmittanceOptics {
     }
 };
 
+struct TransmittanceChapmanOptions {
+    double chapman_unit = kChapmanSeedUnit;
+};
+
 class TransmittanceChapmanModel
     : public TransmittanceModel<TransmittanceChapmanModel, ChapmanTransmittanceOptics> {
   public:
-    explicit TransmittanceChapmanModel(const ModelOptions& options);
+    using Options = TransmittanceChapmanOptions;
+    static const OptionTable<TransmittanceChapmanOptions>& OptionRows();
+    explicit TransmittanceChapmanModel(const TransmittanceChapmanOptions& options);
     static ModelInfo StaticInfo();
     ChapmanTransmittanceOptics MakeOptics(const AtmosphereParameters& atmosphere) const {
         return ChapmanTransmittanceOptics{MakeAnalyticMedia(atmosphere), unit_};
@@ -52,8 +58,9 @@ class TransmittanceChapmanModel
     double unit_ = kChapmanSeedUnit;
 };
 
-// The `--chapman-unit` option shared by `schuler` and `transmittance-chapman`.
-ModelOptionSpec ChapmanUnitOption();
-double ChapmanUnitFromOptions(const ModelOptions& options);
+// The `chapman-unit` option shared by `schuler` and `transmittance-chapman`:
+// its choices (name -> unit) and help.
+std::vector<std::pair<std::string, double>> ChapmanUnitChoices();
+extern const char* const kChapmanUnitHelp;
 
 }  // namespace atmos

@@ -33,7 +33,9 @@ struct ErfcTransmittanceOptics {
 class TransmittanceErfcModel
     : public TransmittanceModel<TransmittanceErfcModel, ErfcTransmittanceOptics> {
   public:
-    explicit TransmittanceErfcModel(const ModelOptions&) { Prepare(EarthAtmosphere()); }
+    using Options = NoOptions;
+    static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
+    explicit TransmittanceErfcModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
     static ModelInfo StaticInfo();
     ErfcTransmittanceOptics MakeOptics(const AtmosphereParameters& atmosphere) const {
         return ErfcTransmittanceOptics{MakeAnalyticMedia(atmosphere)};

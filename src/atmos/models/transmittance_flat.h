@@ -19,7 +19,9 @@ namespace atmos {
 
 class TransmittanceFlatModel : public TransmittanceModel<TransmittanceFlatModel, FlatOptics> {
   public:
-    explicit TransmittanceFlatModel(const ModelOptions&) { Prepare(EarthAtmosphere()); }
+    using Options = NoOptions;
+    static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
+    explicit TransmittanceFlatModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
     static ModelInfo StaticInfo();
     FlatOptics MakeOptics(const AtmosphereParameters& atmosphere) const {
         return FlatOptics{MakeAnalyticMedia(atmosphere)};

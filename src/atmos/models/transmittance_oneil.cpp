@@ -10,20 +10,19 @@ ModelInfo TransmittanceOneilModel::StaticInfo() {
     info.summary = "view-ray transmittance from O'Neil's fitted scale() (refit per atmosphere)";
     info.capabilities = TransmittanceCapabilities();
     info.capabilities.precomputed = true;
-    info.options = {
-        {"fit",
-         ModelOptionSpec::Type::kChoice,
-         "refit",
-         "scale() constants: refit or original",
-         0,
-         0,
-         {"refit", "original"}},
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-TransmittanceOneilModel::TransmittanceOneilModel(const ModelOptions& options) {
-    refit_ = options.GetText("fit") == "refit";
+const OptionTable<TransmittanceOneilOptions>& TransmittanceOneilModel::OptionRows() {
+    static const auto table = OptionTable<TransmittanceOneilOptions>().Choice(
+        "fit", &TransmittanceOneilOptions::refit, {{"refit", true}, {"original", false}},
+        "scale() constants: refit or original");
+    return table;
+}
+
+TransmittanceOneilModel::TransmittanceOneilModel(const TransmittanceOneilOptions& options) {
+    refit_ = options.refit;
     Prepare(EarthAtmosphere());
 }
 

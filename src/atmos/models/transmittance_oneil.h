@@ -12,9 +12,15 @@
 
 namespace atmos {
 
+struct TransmittanceOneilOptions {
+    bool refit = true;  // scale() refitted per medium (false: O'Neil's constants)
+};
+
 class TransmittanceOneilModel : public TransmittanceModel<TransmittanceOneilModel, OneilOptics> {
   public:
-    explicit TransmittanceOneilModel(const ModelOptions& options);
+    using Options = TransmittanceOneilOptions;
+    static const OptionTable<TransmittanceOneilOptions>& OptionRows();
+    explicit TransmittanceOneilModel(const TransmittanceOneilOptions& options);
     static ModelInfo StaticInfo();
     OneilOptics MakeOptics(const AtmosphereParameters& atmosphere) const {
         return MakeOneilOptics(atmosphere, refit_);

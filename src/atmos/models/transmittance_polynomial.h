@@ -69,7 +69,9 @@ PolynomialSigmoid FitPolynomialSigmoid(const AtmosphereParameters& atmosphere,
 class TransmittancePolynomialModel
     : public TransmittanceModel<TransmittancePolynomialModel, PolynomialTransmittanceOptics> {
   public:
-    explicit TransmittancePolynomialModel(const ModelOptions&) { Prepare(EarthAtmosphere()); }
+    using Options = NoOptions;
+    static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
+    explicit TransmittancePolynomialModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
     static ModelInfo StaticInfo();
     PolynomialTransmittanceOptics MakeOptics(const AtmosphereParameters& atmosphere) const {
         return PolynomialTransmittanceOptics{FitPolynomialSigmoid(atmosphere)};

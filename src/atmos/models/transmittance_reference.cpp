@@ -9,14 +9,19 @@ ModelInfo TransmittanceReferenceModel::StaticInfo() {
     info.citation = "seed 003 section 11.3.1";
     info.summary = "view-ray transmittance by a 128-step midpoint Riemann sum (all media)";
     info.capabilities = TransmittanceCapabilities();
-    info.options = {
-        {"steps", ModelOptionSpec::Type::kInteger, "128", "Riemann-sum steps", 1, 1e6, {}},
-    };
+    info.options = OptionRows().Specs();
     return info;
 }
 
-TransmittanceReferenceModel::TransmittanceReferenceModel(const ModelOptions& options) {
-    steps_ = options.GetInt("steps");
+const OptionTable<TransmittanceReferenceOptions>& TransmittanceReferenceModel::OptionRows() {
+    static const auto table = OptionTable<TransmittanceReferenceOptions>().Integer(
+        "steps", &TransmittanceReferenceOptions::steps, 1, 1e6, "", "Riemann-sum steps");
+    return table;
+}
+
+TransmittanceReferenceModel::TransmittanceReferenceModel(
+    const TransmittanceReferenceOptions& options) {
+    steps_ = options.steps;
     Prepare(EarthAtmosphere());
 }
 

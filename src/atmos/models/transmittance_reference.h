@@ -31,10 +31,16 @@ struct ReferenceTransmittanceOptics {
     }
 };
 
+struct TransmittanceReferenceOptions {
+    int steps = 128;  // Riemann-sum steps
+};
+
 class TransmittanceReferenceModel
     : public TransmittanceModel<TransmittanceReferenceModel, ReferenceTransmittanceOptics> {
   public:
-    explicit TransmittanceReferenceModel(const ModelOptions& options);
+    using Options = TransmittanceReferenceOptions;
+    static const OptionTable<TransmittanceReferenceOptions>& OptionRows();
+    explicit TransmittanceReferenceModel(const TransmittanceReferenceOptions& options);
     static ModelInfo StaticInfo();
     ReferenceTransmittanceOptics MakeOptics(const AtmosphereParameters& atmosphere) const;
 
