@@ -93,7 +93,7 @@ TEST(AnalyticFlat, OzoneShellOfEarthIsEq59AndItsChordIsExact) {
 }
 
 // The Chapman approximation (seed 003 Eq. 24-25) against the numerical
-// integral. Bounds found (and written in docs/models.md), viewer at 0-20 km:
+// integral. Bounds found (and written in docs/models/analytic.md), viewer at 0-20 km:
 //   seed unit (Eq. 25 as printed, c = sqrt(r / H)): above the horizon up to
 //   24.1% (near mu = 0.01-0.03; 3.4% at the zenith for H = 8 km; 20.2% at the
 //   horizon, where Ch(x, 90 deg) = sqrt(x) against sqrt(pi x / 2)); the

@@ -4,7 +4,7 @@
 // Not part of the default run (minutes of work): run it with
 //   build/tests/atmos_tests --gtest_also_run_disabled_tests
 //       --gtest_filter='AtmospherePlusStudy.*'
-// It prints the markdown table of docs/models.md.
+// It prints the markdown table of docs/models/atmosphere-plus.md.
 //
 // Stand-in reference: the same model's order-1 quantity evaluated by direct
 // integration at each pixel's exact (h, mu, mu_s) (AtmospherePlusDirectEvaluator:

@@ -212,7 +212,7 @@ TEST(Bruneton, SingleScatteringMatchesDirectIntegration) {
     // many steps, at random (r, mu, mu_s, nu) with the sun above the horizon.
     // The seed's 50 trapezoid intervals: their error dominates for the Mie
     // layer (1.2 km scale height) on long rays; with --scattering-samples 400
-    // the mean error falls to ~0.2 % (docs/models.md).
+    // the mean error falls to ~0.2 % (docs/models/bruneton.md).
     NaiveEvaluator naive;
     naive.atm = EarthAtmosphere();
     naive.steps = 1000;
@@ -604,7 +604,7 @@ TEST(Bruneton, AerialPerspectiveMatchesDirectIntegration) {
 TEST(Bruneton, HorizonArtefactIsMeasured) {
     // Radiance just above and just below the horizon from 5 km, single
     // scattering, table against the naive evaluator: reports the error of the
-    // two halves of the mu table at the horizon (docs/models.md).
+    // two halves of the mu table at the horizon (docs/models/bruneton.md).
     BrunetonConfig c = Small(1);
     c.scattering_r = 16;
     c.scattering_mu = 128;

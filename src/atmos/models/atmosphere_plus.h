@@ -37,7 +37,7 @@
 // lie in the same vertical plane on the same side (azimuth 0); elsewhere the
 // render-time phase functions stand in for the azimuth (2.4.5).
 //
-// Deviations (docs/models.md): the gather G(k-1) is tabulated on the scattering
+// Deviations (docs/models/atmosphere-plus.md): the gather G(k-1) is tabulated on the scattering
 // table's grid and interpolated along the view ray (the seed's solver gathers at
 // every ray sample; same integral, 72x cheaper); Mie "alpha" uses the green
 // channel's beta_M and transmittance (the seed stores one wavelength-independent
@@ -48,7 +48,7 @@
 // lookups interpolate between altitude rows, each row at its own v, and give
 // rays below the horizon at the ground row zero length (AplusSampleTable).
 // Defaults: horizon-centric mapping, 32 x 64 x 32 (the lowest measured table
-// error per MiB, docs/models.md), K = 5, 6 x 12 gather, n = 30.
+// error per MiB, docs/models/atmosphere-plus.md), K = 5, 6 x 12 gather, n = 30.
 // Precomputation: the stage structs of atmosphere_plus_stages.h through
 // RunStage, on the CPU or (CUDA backend) on the device from the same code.
 #pragma once
@@ -285,7 +285,7 @@ struct AtmospherePlusEvaluator {
 // The same model without a table: the factored single scattering evaluated by
 // direct integration at the pixel's exact (h, mu, mu_s) (azimuth omitted as in
 // the table). The stand-in reference for the table error of order-1 tables
-// (tests, docs/models.md); host use only (slow).
+// (tests, docs/models/atmosphere-plus.md); host use only (slow).
 struct AtmospherePlusDirectEvaluator {
     AtmosphereParameters atm;
     int steps = 30, sun_steps = 30;

@@ -15,7 +15,7 @@
 // tangent direction of the triangle it describes (centre, tangent point,
 // observer); the geometric value is c_h = -sqrt(1 - (R_p/(R_p+h))^2). Both are
 // offered (HorizonAngle); the geometric one is the default (a deviation, see
-// docs/models.md).
+// docs/models/atmosphere-plus.md).
 //
 // A texture coordinate t in [0, 1] is the seed's x/(size-1): texel x holds the
 // value at t = x/(size-1) (the sampler maps t onto texel centres).

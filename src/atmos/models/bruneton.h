@@ -37,7 +37,7 @@
 // scattering (transmittance, densities, mapping of r_i and mu_i) are computed
 // once per (r, mu) row and shared by the row's (mu_s, nu) texels. Both are exact
 // rearrangements except for the rotated direction grid. Tables are per unit
-// solar irradiance. The horizon handling: see docs/models.md ("bruneton:
+// solar irradiance. The horizon handling: see docs/models/bruneton.md ("bruneton:
 // horizon").
 #pragma once
 

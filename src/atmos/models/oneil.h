@@ -15,7 +15,7 @@
 // the view part as a difference of two such lengths (camera to x_i).
 //
 // Mapping from our canonical parameters to O'Neil's inputs (documented in
-// docs/models.md):
+// docs/models/oneil.md):
 //   * fInnerRadius, fOuterRadius        = bottom_radius, top_radius (metres, not
 //                                         his 10 / 10.25 units);
 //   * fScaleDepth (0.25 of the thickness) = each medium's scale height H / L_atm:

@@ -104,7 +104,7 @@ struct ReferenceEvaluator {
     // false: the thesis's estimator (seed 003 section 4: one random channel per
     // path, plain delta tracking against the shells' majorant, delta tracking
     // toward the sun, directions sampled uniformly). Kept as the baseline the
-    // spectral estimator is measured against (bench, docs/models.md).
+    // spectral estimator is measured against (bench, docs/models/reference.md).
     bool spectral = true;
     // 1: the sun is a point (directional light, as the other models); < 1: the
     // sun is a uniform disc of angular radius acos(sun_cone_cos), sampled

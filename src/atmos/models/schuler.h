@@ -21,7 +21,7 @@
 // `--chapman-unit seed|half-height`: Eq. 25 as the seed prints it (default) or
 // in Schuler's own unit, the 50% height H ln 2 (physics/analytic_optical_depth.h).
 // Valid: any camera and sun; error of the approximation: tests/analytic_test.cpp
-// (Chapman.*) and docs/models.md.
+// (Chapman.*) and docs/models/schuler.md.
 #pragma once
 
 #include "atmos/atmosphere.h"

@@ -8,7 +8,7 @@
 // rays for segments to the ground); T = exp(-tau). No ozone (as `schuler`).
 // `--chapman-unit seed` (default) is Eq. 25 as printed (unit: the scale
 // height); `half-height` is Schuler's own unit, the 50% height H ln 2.
-// Output: transmittance only. Valid: as the approximation (error: docs/models.md).
+// Output: transmittance only. Valid: as the approximation (error: docs/models/transmittance.md).
 #pragma once
 
 #include "models/transmittance_common.h"

@@ -71,7 +71,7 @@ ATMOS_HD inline double FlatLengthToInfinity(double r, double mu, double scale_he
 // against the exact asymptote sqrt(pi x / 2), 20% low. Schuler's own code
 // measures X and h in units of the 50%-height H ln 2 (exp2 instead of exp):
 // u = ln 2 gives Ch(x, 90 deg) = sqrt(x / ln 2), 4.2% low. Errors of both:
-// tests/analytic_test.cpp (Chapman.*) and docs/models.md.
+// tests/analytic_test.cpp (Chapman.*) and docs/models/analytic.md.
 constexpr double kChapmanSeedUnit = 1.0;
 constexpr double kChapmanHalfHeightUnit = 0.69314718055994531;  // ln 2
 ATMOS_HD inline double ChapmanLengthToInfinity(double r, double mu, double scale_height,
