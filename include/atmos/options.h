@@ -102,35 +102,14 @@ class OptionTable {
     template <typename Access>
     OptionTable&& Integer(const char* name, Access access, double lo, double hi, const char* unit,
                           const char* help) && {
-        using T = OptionFieldType<Options, Access>;
-        ModelOptionSpec spec = Base(name, ModelOptionSpec::Type::kInteger, unit, help);
-        spec.min = lo;
-        spec.max = hi;
-        Add(
-            std::move(spec),
-            [access](Options* o, const std::string& model, const ModelOptionSpec& s,
-                     const std::string& text) {
-                OptionField(*o, access) = static_cast<T>(detail::ParseNumberOption(model, s, text));
-            },
-            [access](Options o) {
-                return FormatOptionNumber(static_cast<double>(OptionField(o, access)));
-            });
+        AddNumber(ModelOptionSpec::Type::kInteger, name, access, lo, hi, unit, help);
         return std::move(*this);
     }
     // A real member in [lo, hi].
     template <typename Access>
     OptionTable&& Real(const char* name, Access access, double lo, double hi, const char* unit,
                        const char* help) && {
-        ModelOptionSpec spec = Base(name, ModelOptionSpec::Type::kReal, unit, help);
-        spec.min = lo;
-        spec.max = hi;
-        Add(
-            std::move(spec),
-            [access](Options* o, const std::string& model, const ModelOptionSpec& s,
-                     const std::string& text) {
-                OptionField(*o, access) = detail::ParseNumberOption(model, s, text);
-            },
-            [access](Options o) { return FormatOptionNumber(OptionField(o, access)); });
+        AddNumber(ModelOptionSpec::Type::kReal, name, access, lo, hi, unit, help);
         return std::move(*this);
     }
     // A member of any type (an enum, a bool, a string) named by one word per value.
@@ -233,6 +212,23 @@ class OptionTable {
         spec.unit = unit;
         spec.help = help;
         return spec;
+    }
+    template <typename Access>
+    void AddNumber(ModelOptionSpec::Type type, const char* name, Access access, double lo,
+                   double hi, const char* unit, const char* help) {
+        using T = OptionFieldType<Options, Access>;
+        ModelOptionSpec spec = Base(name, type, unit, help);
+        spec.min = lo;
+        spec.max = hi;
+        Add(
+            std::move(spec),
+            [access](Options* o, const std::string& model, const ModelOptionSpec& s,
+                     const std::string& text) {
+                OptionField(*o, access) = static_cast<T>(detail::ParseNumberOption(model, s, text));
+            },
+            [access](Options o) {
+                return FormatOptionNumber(static_cast<double>(OptionField(o, access)));
+            });
     }
     void Add(ModelOptionSpec spec, Setter set, Getter get) {
         spec.default_value = get(Options{});
