@@ -218,4 +218,35 @@ TEST(Cli, Help) {
     EXPECT_NE(r.out.find("--steps"), std::string::npos);
 }
 
+// --spp, --seed and --pass-spp: flags of render and sample, for Monte Carlo
+// models only, each validated with one clear error.
+TEST(Cli, MonteCarloFlags) {
+    const std::string out = (TempDir() / "mc.exr").string();
+    const std::string render = "render --view space --size 8x4 -q -o " + out + " ";
+    for (const char* flags : {"--spp 4", "--seed 1", "--pass-spp 2"}) {
+        ExpectError(render + "--model naive " + flags, "apply to Monte Carlo models only");
+        ExpectError(std::string("sample --model naive ") + flags,
+                    "apply to Monte Carlo models only", "altitude_m,mu,mu_s,azimuth_deg\n");
+    }
+    ExpectError(render + "--model reference --spp 0", "--spp must be at least 1");
+    ExpectError(render + "--model reference --seed 4294967296",
+                "--seed must be in [0, 4294967295]");
+    ExpectError(render + "--model reference --seed -1", "--seed must be in [0, 4294967295]");
+    ExpectError(render + "--model reference --pass-spp -1", "--pass-spp must be >= 0");
+    ExpectError("compare --reference naive --reference-seed 3 -o " + out,
+                "need a Monte Carlo reference model");
+    ExpectError("compare --reference-spp 0 -o " + out, "--reference-spp must be at least 1");
+    const Result ok = RunAtmos(render + "--model reference --spp 2 --seed 4294967295 --pass-spp 1");
+    EXPECT_EQ(ok.status, 0) << ok.err;
+    const Result s = RunAtmos("sample --model reference --spp 3 --seed 2",
+                              "altitude_m,mu,mu_s,azimuth_deg\n0,0.5,0.5,0\n");
+    EXPECT_EQ(s.status, 0) << s.err;
+    for (const char* command : {"render", "sample"}) {
+        const Result help = RunAtmos(std::string(command) + " --help");
+        for (const char* flag : {"--spp", "--seed", "--pass-spp"}) {
+            EXPECT_NE(help.out.find(flag), std::string::npos) << command << " " << flag;
+        }
+    }
+}
+
 }  // namespace

@@ -36,6 +36,7 @@
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "cli_common.h"
+#include "cli_monte_carlo.h"
 #include "harness/machine.h"
 #include "render/stages.h"
 
@@ -60,6 +61,7 @@ struct BenchOptions {
     std::string stages_output;
     CLI::Option* repeat_flag = nullptr;
     CLI::Option* warmup_flag = nullptr;
+    MonteCarloFlags monte_carlo;
 };
 
 double Median(std::vector<double> v) {
@@ -125,10 +127,19 @@ int CmdBench(const BenchOptions& o) {
     std::vector<std::string> models = o.models;
     if (models.empty()) {
         for (const ModelInfo& info : ListModels()) {
-            if (info.name != "reference") models.push_back(info.name);
+            if (!info.capabilities.stochastic) models.push_back(info.name);
         }
     }
-    for (const std::string& m : models) GetModelInfo(m);
+    bool any_monte_carlo = false;
+    for (const std::string& m : models) {
+        any_monte_carlo = any_monte_carlo || GetModelInfo(m).capabilities.stochastic;
+    }
+    if (o.monte_carlo.Given() && !any_monte_carlo) {
+        Fail(
+            "--spp, --seed and --pass-spp apply to Monte Carlo models only; none of --models is "
+            "one");
+    }
+    const MonteCarloSettings monte_carlo = o.monte_carlo.Checked();
     for (const std::string& text : o.options) {
         const size_t eq = text.find('=');
         if (eq == std::string::npos || eq == 0) Fail("--option '", text, "': expected NAME=VALUE");
@@ -207,13 +218,7 @@ int CmdBench(const BenchOptions& o) {
                         *std::max_element(prepares.begin(), prepares.end()) * 1e3);
         }
         write_stages(name, "prepare", prepare_stages);
-        int64_t spp = 0;
-        if (stochastic) {
-            const ModelOptions opts(name, model->Info().options, OptionsFor(name, o.options));
-            for (const ModelOptionSpec& spec : model->Info().options) {
-                if (spec.name == "spp") spp = opts.GetInt("spp");
-            }
-        }
+        const int64_t spp = stochastic ? monte_carlo.spp : 0;
         for (const View& view : views) {
             RenderRequest request;
             request.view = view;
@@ -221,6 +226,7 @@ int CmdBench(const BenchOptions& o) {
             request.height = height;
             request.quantity = quantity;
             request.show_progress = false;
+            request.monte_carlo = monte_carlo;
             Image image;
             std::vector<double> times;
             std::vector<StageRuns> frame_stages;
@@ -292,7 +298,7 @@ Command AddBenchCommand(CLI::App* root) {
         ->delimiter(',');
     cmd->add_option("--option", o->options,
                     "NAME=VALUE: a model option, given to every model of --models that has it "
-                    "(repeatable; e.g. spp=256)")
+                    "(repeatable; e.g. steps=32)")
         ->allow_extra_args(false);
     cmd->add_option("--prepare-repeat", o->prepare_repeat,
                     "Prepare() runs per model; the median is reported (default 1)")
@@ -316,6 +322,7 @@ Command AddBenchCommand(CLI::App* root) {
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("-o,--output", o->output, "CSV file")->capture_default_str();
+    AddMonteCarloFlags(cmd, &o->monte_carlo);
     Command c;
     c.app = cmd;
     c.run = [o] { return CmdBench(*o); };

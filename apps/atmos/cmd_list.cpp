@@ -40,6 +40,9 @@ int CmdList() {
             "", c.radiance ? "radiance" : "", c.radiance && c.transmittance ? ", " : "",
             c.transmittance ? "transmittance" : "", c.space_views ? "yes" : "no",
             c.sun_below_horizon ? "yes" : "no", c.multiple_scattering ? "yes" : "no");
+        if (c.stochastic) {
+            std::printf("  %-16s   Monte Carlo: takes --spp, --seed, --pass-spp\n", "");
+        }
         for (const ModelOptionSpec& spec : info.options) {
             std::printf("  %-16s   --%s (default %s): %s\n", "", spec.name.c_str(),
                         spec.default_value.c_str(), spec.help.c_str());
