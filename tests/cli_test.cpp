@@ -4,12 +4,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "atmos/image.h"
 #include "base/parallel.h"
@@ -245,6 +247,50 @@ TEST(Cli, MonteCarloFlags) {
         const Result help = RunAtmos(std::string(command) + " --help");
         for (const char* flag : {"--spp", "--seed", "--pass-spp"}) {
             EXPECT_NE(help.out.find(flag), std::string::npos) << command << " " << flag;
+        }
+    }
+}
+
+// Issue 18 item 1: a kill at any write, fsync or rename of a checkpoint
+// (fault injection with strace) never makes --resume give a wrong image: a
+// render of 4 spp is checkpointed, extending it to 8 is killed at the k-th such
+// call, and the resumed render is the uninterrupted one.
+TEST(Cli, CheckpointSurvivesAKillAtEveryWriteAndRename) {
+    if (std::system("strace -o /dev/null true > /dev/null 2>&1") != 0) {
+        GTEST_SKIP() << "strace is not available";
+    }
+    const fs::path dir = TempDir() / "kill";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string base =
+        "render --model reference --view plane-dawn --size 24x12 -q --seed 3 "
+        "--pass-spp 2 --checkpoint " +
+        (dir / "ck").string() + " ";
+    const Result full = RunAtmos(base + "--spp 8 -o " + (dir / "full.exr").string());
+    ASSERT_EQ(full.status, 0) << full.err;
+    const std::string want = Slurp(dir / "full.exr");
+    // The checkpoint's write and fsync, the directory's fsync, its one rename,
+    // and the output image's first write (the checkpoint then is complete).
+    const std::pair<const char*, int> faults[] = {
+        {"write", 1}, {"write", 2}, {"fsync", 1}, {"fsync", 2}, {"rename,renameat,renameat2", 1}};
+    for (const auto& [call, when] : faults) {
+        {
+            fs::remove(dir / "ck.bin");
+            ASSERT_EQ(RunAtmos(base + "--spp 4 -o " + (dir / "half.exr").string()).status, 0);
+            const std::string inject = std::string("strace -f -o /dev/null -e trace=") + call +
+                                       " -e inject=" + call +
+                                       ":error=EIO:signal=SIGKILL:when=" + std::to_string(when) +
+                                       " " + ATMOS_CLI_PATH + " ";
+            const std::string killed = inject + base + "--spp 8 --resume -o " +
+                                       (dir / "killed.exr").string() + " > /dev/null 2>&1";
+            const int raw = std::system(killed.c_str());
+            EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 128 + SIGKILL)
+                << call << " " << when << ": the injected kill did not happen";
+            fs::remove(dir / "resumed.exr");
+            const Result resumed =
+                RunAtmos(base + "--spp 8 --resume -o " + (dir / "resumed.exr").string());
+            ASSERT_EQ(resumed.status, 0) << call << " " << when << ": " << resumed.err;
+            EXPECT_TRUE(Slurp(dir / "resumed.exr") == want) << call << " " << when;
         }
     }
 }

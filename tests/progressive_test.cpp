@@ -7,6 +7,9 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
 #include <memory>
 
 #include "atmos/atmosphere.h"
@@ -199,6 +202,76 @@ TEST(Progressive, SettingsAreValidatedWithOneClearError) {
     Image image;
     EXPECT_THROW(model.Render(CoinRequest(0, 0), &image), Error);
     EXPECT_THROW(model.Render(CoinRequest(4, -1), &image), Error);
+}
+
+// Issue 18 item 1: --resume verifies what it reads. A truncated or damaged
+// checkpoint, counts that disagree, or a sum that is not finite (each with a
+// valid checksum where the damage is not the checksum's to find) is one clear
+// error, never a wrong image.
+TEST(Progressive, ADamagedCheckpointIsOneClearError) {
+    const CoinModel model(true);
+    const std::filesystem::path dir = TestDir("progressive_damaged");
+    RenderRequest request = CoinRequest(6, 3);
+    request.checkpoint = (dir / "coin").string();
+    Image image;
+    model.Render(request, &image);
+    const std::string path = request.checkpoint + ".bin";
+    std::string good;
+    {
+        std::ifstream f(path, std::ios::binary);
+        good.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+    }
+    ASSERT_GT(good.size(), 16u + 2 * 5 * 3 * 3 * sizeof(float));
+    auto write = [&](const std::string& bytes) {
+        std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+    };
+    // Recomputes the trailing FNV-1a checksum after an edit.
+    auto resum = [](std::string bytes) {
+        uint64_t h = 14695981039346656037ull;
+        for (size_t i = 0; i + 8 < bytes.size(); ++i) {
+            h ^= static_cast<unsigned char>(bytes[i]);
+            h *= 1099511628211ull;
+        }
+        std::memcpy(&bytes[bytes.size() - 8], &h, 8);
+        return bytes;
+    };
+    request.monte_carlo.spp = 12;
+    request.resume = true;
+    auto expect_damaged = [&](const std::string& bytes, const char* why) {
+        write(bytes);
+        try {
+            model.Render(request, &image);
+            ADD_FAILURE() << "resumed from a checkpoint with " << why;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("is damaged"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+        }
+    };
+    expect_damaged(good.substr(0, good.size() - 100), "checksum");
+    expect_damaged(good.substr(0, 12), "truncated");
+    std::string flipped = good;
+    flipped[good.size() - 20] ^= 0x10;
+    expect_damaged(flipped, "checksum");
+    const size_t at = good.find("\"samples_done\":6");
+    ASSERT_NE(at, std::string::npos);
+    std::string counts = good;
+    counts[at + 15] = '2';  // 2 samples in 2 passes of 3
+    expect_damaged(resum(counts), "counts disagree");
+    std::string nan = good;
+    const float q = std::numeric_limits<float>::quiet_NaN();
+    std::memcpy(&nan[good.size() - 8 - 4], &q, 4);
+    expect_damaged(resum(nan), "not finite");
+    std::string longer = good;
+    longer.insert(good.size() - 8, 4, '\0');
+    expect_damaged(resum(longer), "wrong size");
+    // The intact checkpoint resumes to the uninterrupted image.
+    write(good);
+    Image resumed, full;
+    model.Render(request, &resumed);
+    model.Render(CoinRequest(12, 3), &full);
+    EXPECT_EQ(std::memcmp(resumed.data(), full.data(), full.size() * sizeof(float)), 0);
+    // The temporary file is gone once committed.
+    EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
 }
 
 }  // namespace

@@ -360,7 +360,7 @@ TEST(ReferenceDeterminism, SameImageForAnyThreadCountAndAfterResume) {
     checkpointed.monte_carlo.spp = 4;
     Image partial;
     model->Render(checkpointed, &partial);
-    ASSERT_TRUE(std::filesystem::exists(dir / "ckpt.json"));
+    ASSERT_TRUE(std::filesystem::exists(dir / "ckpt.bin"));
     checkpointed.monte_carlo.spp = 8;
     checkpointed.resume = true;
     Image resumed, variance;

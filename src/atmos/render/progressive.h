@@ -4,8 +4,10 @@
 // the model provides one pass (Model::RenderPass: the mean of a range of
 // samples, from a seed), and the driver runs the passes of
 // RenderRequest::monte_carlo, weights them by their sample counts, writes
-// checkpoints (the sums, the sums of squares and the counts) at most every 10 s
-// and after the last pass, resumes from one, and estimates the variance of the
+// checkpoints (one file, STEM.bin: the sums, the sums of squares, the counts and
+// a checksum, committed atomically) at most every 10 s and after the last pass,
+// resumes from one (verifying sizes, counts, checksum and finiteness: one clear
+// error otherwise, never a wrong image), and estimates the variance of the
 // mean from the pass means (batch means). Random numbers depend on (seed,
 // pixel, sample index) only (base/rng.h), so a render split into passes, or
 // interrupted and resumed, is the same image.
