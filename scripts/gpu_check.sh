@@ -83,7 +83,7 @@ for phase in "${phases[@]}"; do
                 "${models_arg[@]}" -o "$OUT/bench_cpu.csv" ;;
         paths)
             run paths "$B/atmos" bench --backend cuda --models reference --size "$SIZE" \
-                --option spp=64 --repeat 1 --warmup 1 -o "$OUT/bench_paths.csv" ;;
+                --spp 64 --repeat 1 --warmup 1 -o "$OUT/bench_paths.csv" ;;
         roofline)
             metrics=dram__bytes_read.sum,dram__bytes_write.sum,gpu__time_duration.sum
             for op in fadd fmul ffma dadd dmul dfma; do

@@ -4,12 +4,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "atmos/error.h"
 #include "atmos/image.h"
@@ -231,7 +233,7 @@ TEST(Cli, Help) {
         const Result r = RunAtmos(std::string(command) + " --help");
         EXPECT_EQ(r.status, 0) << command;
         EXPECT_NE(r.out.find("--model"), std::string::npos) << command;
-        for (const char* model_option : {"--steps", "--orders", "--spp", "--turbidity"}) {
+        for (const char* model_option : {"--steps", "--orders", "--max-order", "--turbidity"}) {
             EXPECT_EQ(r.out.find(model_option), std::string::npos)
                 << command << " " << model_option;
         }
@@ -283,6 +285,81 @@ TEST(Cli, ListModelPrintsItsOwnDefaults) {
     EXPECT_NE(RunAtmos("list atmosphere-plus").out.find("default 5"), std::string::npos);
     EXPECT_NE(RunAtmos("list bruneton").out.find("default 4"), std::string::npos);
     ExpectError("list nope", "unknown model 'nope'");
+}
+
+// --spp, --seed and --pass-spp: flags of render and sample, for Monte Carlo
+// models only, each validated with one clear error.
+TEST(Cli, MonteCarloFlags) {
+    const std::string out = (TempDir() / "mc.exr").string();
+    const std::string render = "render --view space --size 8x4 -q -o " + out + " ";
+    for (const char* flags : {"--spp 4", "--seed 1", "--pass-spp 2"}) {
+        ExpectError(render + "--model naive " + flags, "apply to Monte Carlo models only");
+        ExpectError(std::string("sample --model naive ") + flags,
+                    "apply to Monte Carlo models only", "altitude_m,mu,mu_s,azimuth_deg\n");
+    }
+    ExpectError(render + "--model reference --spp 0", "--spp must be at least 1");
+    ExpectError(render + "--model reference --seed 4294967296",
+                "--seed must be in [0, 4294967295]");
+    ExpectError(render + "--model reference --seed -1", "--seed must be in [0, 4294967295]");
+    ExpectError(render + "--model reference --pass-spp -1", "--pass-spp must be >= 0");
+    ExpectError("compare --reference naive --reference-seed 3 -o " + out,
+                "need a Monte Carlo reference model");
+    ExpectError("compare --reference-spp 0 -o " + out, "--reference-spp must be at least 1");
+    const Result ok = RunAtmos(render + "--model reference --spp 2 --seed 4294967295 --pass-spp 1");
+    EXPECT_EQ(ok.status, 0) << ok.err;
+    const Result s = RunAtmos("sample --model reference --spp 3 --seed 2",
+                              "altitude_m,mu,mu_s,azimuth_deg\n0,0.5,0.5,0\n");
+    EXPECT_EQ(s.status, 0) << s.err;
+    for (const char* command : {"render", "sample"}) {
+        const Result help = RunAtmos(std::string(command) + " --help");
+        for (const char* flag : {"--spp", "--seed", "--pass-spp"}) {
+            EXPECT_NE(help.out.find(flag), std::string::npos) << command << " " << flag;
+        }
+    }
+}
+
+// Issue 18 item 1: a kill at any write, fsync or rename of a checkpoint
+// (fault injection with strace) never makes --resume give a wrong image: a
+// render of 4 spp is checkpointed, extending it to 8 is killed at the k-th such
+// call, and the resumed render is the uninterrupted one.
+TEST(Cli, CheckpointSurvivesAKillAtEveryWriteAndRename) {
+    if (std::system("strace -o /dev/null true > /dev/null 2>&1") != 0) {
+        GTEST_SKIP() << "strace is not available";
+    }
+    const fs::path dir = TempDir() / "kill";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string base =
+        "render --model reference --view plane-dawn --size 24x12 -q --seed 3 "
+        "--pass-spp 2 --checkpoint " +
+        (dir / "ck").string() + " ";
+    const Result full = RunAtmos(base + "--spp 8 -o " + (dir / "full.exr").string());
+    ASSERT_EQ(full.status, 0) << full.err;
+    const std::string want = Slurp(dir / "full.exr");
+    // The checkpoint's write and fsync, the directory's fsync, its one rename,
+    // and the output image's first write (the checkpoint then is complete).
+    const std::pair<const char*, int> faults[] = {
+        {"write", 1}, {"write", 2}, {"fsync", 1}, {"fsync", 2}, {"rename,renameat,renameat2", 1}};
+    for (const auto& [call, when] : faults) {
+        {
+            fs::remove(dir / "ck.bin");
+            ASSERT_EQ(RunAtmos(base + "--spp 4 -o " + (dir / "half.exr").string()).status, 0);
+            const std::string inject = std::string("strace -f -o /dev/null -e trace=") + call +
+                                       " -e inject=" + call +
+                                       ":error=EIO:signal=SIGKILL:when=" + std::to_string(when) +
+                                       " " + ATMOS_CLI_PATH + " ";
+            const std::string killed = inject + base + "--spp 8 --resume -o " +
+                                       (dir / "killed.exr").string() + " > /dev/null 2>&1";
+            const int raw = std::system(killed.c_str());
+            EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 128 + SIGKILL)
+                << call << " " << when << ": the injected kill did not happen";
+            fs::remove(dir / "resumed.exr");
+            const Result resumed =
+                RunAtmos(base + "--spp 8 --resume -o " + (dir / "resumed.exr").string());
+            ASSERT_EQ(resumed.status, 0) << call << " " << when << ": " << resumed.err;
+            EXPECT_TRUE(Slurp(dir / "resumed.exr") == want) << call << " " << when;
+        }
+    }
 }
 
 }  // namespace

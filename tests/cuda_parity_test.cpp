@@ -131,9 +131,11 @@ TEST(CudaParity, SampleMatchesTheCpu) {
 TEST(CudaParity, PathTracerAgreesStatistically) {
     ATMOS_SKIP_WITHOUT_DEVICE();
     const AtmosphereParameters atm = EarthAtmosphere();
-    std::unique_ptr<Model> model = CreateModel("reference", {{"spp", "64"}, {"pass-spp", "8"}});
+    std::unique_ptr<Model> model = CreateModel("reference");
     model->Prepare(atm);
     RenderRequest request = SmallRequest("ground-sunrise", atm, Quantity::kRadiance);
+    request.monte_carlo.spp = 64;
+    request.monte_carlo.pass_spp = 8;
     request.width = 32;
     request.height = 18;
     Image cpu_var, gpu_var;

@@ -325,9 +325,12 @@ TEST(ReferenceSymmetry, MirroredViewGivesMirroredImage) {
 }
 
 TEST(ReferenceDeterminism, SameImageForAnyThreadCountAndAfterResume) {
-    auto model = CreateModel("reference", {{"spp", "8"}, {"pass-spp", "2"}, {"seed", "5"}});
+    auto model = CreateModel("reference");
     model->Prepare(EarthAtmosphere());
     RenderRequest request;
+    request.monte_carlo.spp = 8;
+    request.monte_carlo.pass_spp = 2;
+    request.monte_carlo.seed = 5;
     request.view = GetView("plane-sunrise", EarthAtmosphere());
     request.width = 24;
     request.height = 13;
@@ -354,11 +357,11 @@ TEST(ReferenceDeterminism, SameImageForAnyThreadCountAndAfterResume) {
     std::filesystem::create_directories(dir);
     RenderRequest checkpointed = request;
     checkpointed.checkpoint = (dir / "ckpt").string();
-    auto half = CreateModel("reference", {{"spp", "4"}, {"pass-spp", "2"}, {"seed", "5"}});
-    half->Prepare(EarthAtmosphere());
+    checkpointed.monte_carlo.spp = 4;
     Image partial;
-    half->Render(checkpointed, &partial);
-    ASSERT_TRUE(std::filesystem::exists(dir / "ckpt.json"));
+    model->Render(checkpointed, &partial);
+    ASSERT_TRUE(std::filesystem::exists(dir / "ckpt.bin"));
+    checkpointed.monte_carlo.spp = 8;
     checkpointed.resume = true;
     Image resumed, variance;
     checkpointed.variance = &variance;
@@ -371,14 +374,17 @@ TEST(ReferenceDeterminism, SameImageForAnyThreadCountAndAfterResume) {
         var_sum += static_cast<double>(variance.data()[i]);
     }
     EXPECT_GT(var_sum, 0.0);
-    // A checkpoint of another render is refused.
-    auto other = CreateModel("reference", {{"spp", "8"}, {"pass-spp", "2"}, {"seed", "6"}});
+    // A checkpoint of another render (seed, model option) is refused.
+    checkpointed.monte_carlo.seed = 6;
+    EXPECT_THROW(model->Render(checkpointed, &resumed), Error);
+    checkpointed.monte_carlo.seed = 5;
+    auto other = CreateModel("reference", {{"max-order", "3"}});
     other->Prepare(EarthAtmosphere());
     EXPECT_THROW(other->Render(checkpointed, &resumed), Error);
 }
 
 TEST(Reference, FiniteNonNegativeInEveryView) {
-    auto model = CreateModel("reference", {{"spp", "2"}});
+    auto model = CreateModel("reference");
     const AtmosphereParameters atm = LoadAtmosphere("earth-bruneton");  // albedo 0.1: bounces
     model->Prepare(atm);
     for (const View& view : StandardViews(atm)) {
@@ -387,6 +393,7 @@ TEST(Reference, FiniteNonNegativeInEveryView) {
         request.width = 16;
         request.height = 9;
         request.show_progress = false;
+        request.monte_carlo.spp = 2;
         Image image;
         model->Render(request, &image);
         for (size_t i = 0; i < image.size(); ++i) {
@@ -410,9 +417,10 @@ TEST(Reference, TransmittanceOnlyWhereUsedAndTheSunDiscUsesIt) {
     // A camera looking at the sun through a 0.1 degree field: every pixel in its disc.
     view.camera =
         MakeCamera(view.camera.position, view.sun_direction, Normalize(view.camera.position), 0.1);
-    std::unique_ptr<Model> model = CreateModel("reference", {{"spp", "4"}});
+    std::unique_ptr<Model> model = CreateModel("reference");
     model->Prepare(atm);
     RenderRequest r;
+    r.monte_carlo.spp = 4;
     r.view = view;
     r.width = 4;
     r.height = 4;

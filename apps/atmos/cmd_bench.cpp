@@ -36,6 +36,7 @@
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "cli_common.h"
+#include "cli_monte_carlo.h"
 #include "harness/machine.h"
 #include "render/stages.h"
 
@@ -59,6 +60,7 @@ struct BenchOptions {
     std::string stages_output;
     CLI::Option* repeat_flag = nullptr;
     CLI::Option* warmup_flag = nullptr;
+    MonteCarloFlags monte_carlo;
 };
 
 double Median(std::vector<double> v) {
@@ -110,9 +112,19 @@ int CmdBench(const BenchOptions& o) {
     for (const std::string& m : o.models) models.push_back(ParseModelSpec(m));
     if (models.empty()) {
         for (const ModelInfo& info : ListModels()) {
-            if (info.name != "reference") models.push_back(ParseModelSpec(info.name));
+            if (!info.capabilities.stochastic) models.push_back(ParseModelSpec(info.name));
         }
     }
+    bool any_monte_carlo = false;
+    for (const ModelSpec& m : models) {
+        any_monte_carlo = any_monte_carlo || GetModelInfo(m.name).capabilities.stochastic;
+    }
+    if (o.monte_carlo.Given() && !any_monte_carlo) {
+        Fail(
+            "--spp, --seed and --pass-spp apply to Monte Carlo models only; none of --models is "
+            "one");
+    }
+    const MonteCarloSettings monte_carlo = o.monte_carlo.Checked();
     if (o.prepare_repeat < 1) Fail("--prepare-repeat must be at least 1");
     std::vector<View> views;
     for (const std::string& v : o.views.empty() ? StandardViewNames() : o.views) {
@@ -183,12 +195,7 @@ int CmdBench(const BenchOptions& o) {
                         *std::max_element(prepares.begin(), prepares.end()) * 1e3);
         }
         write_stages(name, "prepare", prepare_stages);
-        int64_t spp = 0;
-        if (stochastic) {
-            for (const auto& [option, value] : ResolveModelOptions(spec.name, spec.options)) {
-                if (option == "spp") spp = std::stoll(value);
-            }
-        }
+        const int64_t spp = stochastic ? monte_carlo.spp : 0;
         for (const View& view : views) {
             RenderRequest request;
             request.view = view;
@@ -196,6 +203,7 @@ int CmdBench(const BenchOptions& o) {
             request.height = height;
             request.quantity = quantity;
             request.show_progress = false;
+            request.monte_carlo = monte_carlo;
             Image image;
             std::vector<double> times;
             std::vector<StageRuns> frame_stages;
@@ -289,6 +297,7 @@ Command AddBenchCommand(CLI::App* root) {
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("-o,--output", o->output, "CSV file")->capture_default_str();
+    AddMonteCarloFlags(cmd, &o->monte_carlo);
     Command c;
     c.app = cmd;
     c.run = [o] { return CmdBench(*o); };

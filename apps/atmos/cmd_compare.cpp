@@ -1,5 +1,6 @@
 // atmos CLI: `atmos compare`: every model against the reference at the 12 views
 // (src/atmos/harness/compare.h), tables + images + index.html.
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -13,6 +14,7 @@
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "harness/compare.h"
+#include "render/progressive.h"
 
 namespace atmos::cli {
 
@@ -27,8 +29,10 @@ struct CompareCliOptions {
     std::string size = "320x180";
     std::string quantity = "radiance";
     std::string reference;
-    int reference_spp = kDefaultReferenceSpp;
+    int64_t reference_spp = kDefaultReferenceSpp;
+    int64_t reference_seed = 0;
     CLI::Option* spp_flag = nullptr;
+    CLI::Option* seed_flag = nullptr;
     std::string atmosphere = "earth";
     std::string output;
     std::string cache = "out/cache";
@@ -45,13 +49,6 @@ struct CompareCliOptions {
 bool IsRegistered(const std::string& name) {
     for (const ModelInfo& info : ListModels()) {
         if (info.name == name) return true;
-    }
-    return false;
-}
-
-bool HasOption(const std::string& model, const std::string& option) {
-    for (const ModelOptionSpec& s : GetModelInfo(model).options) {
-        if (s.name == option) return true;
     }
     return false;
 }
@@ -78,7 +75,7 @@ int CmdCompare(const CompareCliOptions& o) {
     config.command_line = o.command_line;
 
     // The reference: `reference` (the path tracer) when registered, else a stand-in.
-    const bool spp_given = o.spp_flag->count() > 0;
+    const bool monte_carlo_given = o.spp_flag->count() + o.seed_flag->count() > 0;
     if (!o.reference.empty()) {
         const ModelSpec reference = ParseModelSpec(o.reference);
         config.reference_model = reference.name;
@@ -93,13 +90,12 @@ int CmdCompare(const CompareCliOptions& o) {
         config.reference_note =
             "stand-in: the path tracer `reference` is not registered in this build";
     }
-    if (HasOption(config.reference_model, "spp")) {
-        if (config.reference_options.count("spp") == 0) {
-            config.reference_options["spp"] = std::to_string(o.reference_spp);
-        }
-    } else if (spp_given) {
-        Fail("--reference-spp needs a reference model with an `spp` option (",
-             config.reference_model, " has none)");
+    if (GetModelInfo(config.reference_model).capabilities.stochastic) {
+        config.reference_monte_carlo = MakeMonteCarloSettings(
+            o.reference_spp, o.reference_seed, 0, "--reference-spp", "--reference-seed");
+    } else if (monte_carlo_given) {
+        Fail("--reference-spp and --reference-seed need a Monte Carlo reference model (",
+             config.reference_model, " is not one)");
     }
     CreateModel(config.reference_model, config.reference_options);  // validate the options
 
@@ -135,9 +131,12 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
     cmd->add_option("--quantity", o->quantity, "radiance (HDR-FLIP) or transmittance (LDR-FLIP)")
         ->capture_default_str();
     o->spp_flag = cmd->add_option("--reference-spp", o->reference_spp,
-                                  "samples per pixel of the path-traced reference")
-                      ->capture_default_str()
-                      ->check(CLI::PositiveNumber);
+                                  "paths per pixel of a Monte Carlo reference (two halves of "
+                                  "spp/2, seeds 2s+1 and 2s+2)")
+                      ->capture_default_str();
+    o->seed_flag = cmd->add_option("--reference-seed", o->reference_seed,
+                                   "random seed s of a Monte Carlo reference, in [0, 4294967295]")
+                       ->capture_default_str();
     cmd->add_option("--reference", o->reference,
                     "reference model and its options, NAME[:OPTION=VALUE...] (default: "
                     "`reference` when registered, else naive:steps=256:light-steps=64)");

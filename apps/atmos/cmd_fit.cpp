@@ -14,6 +14,7 @@
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "models/neural_train.h"
+#include "render/progressive.h"
 
 namespace atmos::cli {
 
@@ -24,7 +25,7 @@ struct FitOptions {
     std::string atmosphere = "earth";
     std::vector<std::string> sets;
     std::string reference = "bruneton";
-    int reference_spp = 64;
+    int64_t reference_spp = 64;
     std::string output;
     int threads = 0;
     bool quiet = false;
@@ -37,17 +38,16 @@ int CmdFit(const FitOptions& o) {
     if (o.output.empty()) Fail("fit: -o FILE.json is required");
     ThreadLimit limit(o.threads);
     const AtmosphereParameters atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
-    ModelSpec spec = ParseModelSpec(o.reference);
+    const ModelSpec spec = ParseModelSpec(o.reference);
     if (spec.name == o.model) Fail("fit: --reference cannot be the model being fitted");
-    if (spec.name == "reference" && spec.options.count("spp") == 0) {
-        spec.options["spp"] = std::to_string(o.reference_spp);
-    }
     std::unique_ptr<Model> reference = CreateModel(spec);
+    NeuralFitOptions fit = o.fit;
+    fit.reference_monte_carlo = MakeMonteCarloSettings(o.reference_spp, 0, 0, "--reference-spp");
     const auto t0 = std::chrono::steady_clock::now();
     reference->Prepare(atmosphere);
     const double prepare_s = Seconds(t0);
     NeuralFitReport report;
-    NeuralWeights w = FitNeural(*reference, atmosphere, o.fit, &report);
+    NeuralWeights w = FitNeural(*reference, atmosphere, fit, &report);
     // Record where the data came from.
     {
         std::string t = w.training_json;
@@ -95,7 +95,9 @@ Command AddFitCommand(CLI::App* root) {
                      "model sampled for the training data, NAME[:OPTION=VALUE...]: bruneton "
                      "(fast) or reference (path tracer)")
         ->capture_default_str();
-    c.app->add_option("--reference-spp", o->reference_spp, "samples per query for the path tracer")
+    c.app
+        ->add_option("--reference-spp", o->reference_spp,
+                     "paths per query of a Monte Carlo reference (the path tracer)")
         ->capture_default_str();
     c.app
         ->add_option("--network", o->fit.network,

@@ -19,6 +19,7 @@
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "cli_common.h"
+#include "cli_monte_carlo.h"
 #include "harness/gallery.h"
 
 namespace fs = std::filesystem;
@@ -36,6 +37,7 @@ struct RenderOptions {
     float exposure = 0.0f;   // 0: the view's
     std::string checkpoint;  // Monte Carlo models: checkpoint stem (default: OUTPUT.ckpt)
     bool resume = false;
+    MonteCarloFlags monte_carlo;
 };
 
 int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
@@ -53,6 +55,7 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     const BackendScope backend(ParseBackend(common.backend));
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(GivenModel(common));
+    const MonteCarloSettings monte_carlo = ro.monte_carlo.Settings(model->Info());
     std::vector<View> views;
     if (all_views) {
         views = StandardViews(atmosphere);
@@ -75,6 +78,7 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         request.quantity = quantity;
         request.sun_disc = ro.sun_disc;
         request.show_progress = !common.quiet;
+        request.monte_carlo = monte_carlo;
         const bool stochastic = model->Info().capabilities.stochastic;
         Image variance;
         std::string out_stem = fs::path(ro.output).replace_extension().string();
@@ -147,6 +151,7 @@ Command AddRenderCommand(CLI::App* root) {
                        "extension + .ckpt); checkpoints hold the sums and the sample count");
     render->add_flag("--resume", ro->resume,
                      "Monte Carlo models: continue from the checkpoint of the same render");
+    AddMonteCarloFlags(render, &ro->monte_carlo);
     c.app = render;
     c.run = [common, ro] { return CmdRender(*common, *ro); };
     return c;

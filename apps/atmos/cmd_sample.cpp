@@ -19,7 +19,9 @@
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "cli_common.h"
+#include "cli_monte_carlo.h"
 #include "harness/gallery.h"
+#include "render/progressive.h"
 
 namespace fs = std::filesystem;
 
@@ -86,14 +88,17 @@ std::vector<SampleQuery> ReadQueries(std::istream& in) {
     return queries;
 }
 
-int CmdSample(const CommonOptions& common) {
+int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags) {
     ThreadLimit limit(common.threads);
     const BackendScope backend(ParseBackend(common.backend));
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(GivenModel(common));
+    const MonteCarloSettings monte_carlo = flags.Settings(model->Info());
     const std::vector<SampleQuery> queries = ReadQueries(std::cin);
     PrepareModel(common, atmosphere, model.get());
-    const std::vector<SampleAnswer> answers = model->Sample(queries);
+    const std::vector<SampleAnswer> answers = model->Info().capabilities.stochastic
+                                                  ? SampleMonteCarlo(*model, queries, monte_carlo)
+                                                  : model->Sample(queries);
     std::printf("altitude_m,mu,mu_s,azimuth_deg,L_r,L_g,L_b,T_r,T_g,T_b\n");
     for (size_t i = 0; i < queries.size(); ++i) {
         const SampleQuery& q = queries[i];
@@ -111,12 +116,14 @@ int CmdSample(const CommonOptions& common) {
 
 Command AddSampleCommand(CLI::App* root) {
     auto common = std::make_shared<CommonOptions>();
+    auto flags = std::make_shared<MonteCarloFlags>();
     Command c;
     c.app = root->add_subcommand(
         "sample", "evaluate a model at queries read as CSV from stdin, answers to stdout");
     AddCommonOptions(c.app, common.get());
     AddBackendOption(c.app, &common->backend);
-    c.run = [common] { return CmdSample(*common); };
+    AddMonteCarloFlags(c.app, flags.get());
+    c.run = [common, flags] { return CmdSample(*common, *flags); };
     return c;
 }
 

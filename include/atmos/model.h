@@ -7,6 +7,7 @@
 // per-pixel loop (src/atmos/render/render.h) calls.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -32,7 +33,10 @@ struct ModelCapabilities {
     bool sun_below_horizon = true;  // valid with the sun below the horizon
     bool multiple_scattering = false;
     bool precomputed = false;  // Prepare() builds tables or fits
-    bool stochastic = false;   // Monte Carlo: output depends on --seed / --spp
+    // Monte Carlo: the output depends on MonteCarloSettings (spp, seed); the
+    // model renders passes and the progressive driver (src/atmos/render/
+    // progressive.h) runs them, with checkpoints, resume and the variance.
+    bool stochastic = false;
 };
 
 struct ModelInfo {
@@ -70,6 +74,26 @@ struct SampleAnswer {
     Rgb transmittance;
 };
 
+// How a Monte Carlo model (ModelCapabilities::stochastic) estimates: `spp`
+// paths per pixel (per query for sample) from `seed`, rendered in passes of
+// `pass_spp` paths (0: spp / 8 in [1, 64]), the granularity of checkpoints and
+// of the variance estimate. Other models ignore it.
+struct MonteCarloSettings {
+    int64_t spp = 64;
+    uint64_t seed = 0;
+    int64_t pass_spp = 0;
+};
+
+// One pass of a Monte Carlo model: the mean of samples [first_sample,
+// first_sample + samples) of every pixel or query, random numbers from `seed`.
+struct MonteCarloPass {
+    uint64_t seed = 0;
+    int64_t first_sample = 0;
+    int64_t samples = 1;
+};
+
+class Progress;
+
 struct RenderRequest {
     View view;
     int width = 480;
@@ -77,9 +101,11 @@ struct RenderRequest {
     Quantity quantity = Quantity::kRadiance;
     bool sun_disc = false;  // add the sun's disc (radiance E / (pi alpha^2) times T)
     bool show_progress = true;
-    // Monte Carlo models (ModelCapabilities::stochastic): checkpoint file stem
-    // (empty: no checkpoints), whether to resume from it, and an optional image
-    // that receives the per-pixel variance of the estimate (same units squared).
+    // Monte Carlo models (ModelCapabilities::stochastic): the estimate, the
+    // checkpoint file stem (empty: no checkpoints), whether to resume from it,
+    // and an optional image that receives the per-pixel variance of the
+    // estimate (same units squared). Others ignore them.
+    MonteCarloSettings monte_carlo;
     std::string checkpoint;
     bool resume = false;
     Image* variance = nullptr;
@@ -96,6 +122,19 @@ class Model {
     // atmosphere's solar irradiance) or transmittance into `out` (resized).
     virtual void Render(const RenderRequest& request, Image* out) const = 0;
     virtual std::vector<SampleAnswer> Sample(const std::vector<SampleQuery>& queries) const = 0;
+
+    // Monte Carlo models (ModelCapabilities::stochastic) provide one pass; the
+    // progressive driver (src/atmos/render/progressive.h) runs the passes and
+    // is their Render and Sample. RenderPass renders the pass's mean into `out`
+    // (resized), advancing `progress` (may be null) by one per pixel; PassKey
+    // is JSON text of everything of the model that determines a pass besides
+    // the request (options, atmosphere): a checkpoint resumes only the same.
+    // Others throw atmos::Error.
+    virtual void RenderPass(const RenderRequest& request, const MonteCarloPass& pass, Image* out,
+                            Progress* progress) const;
+    virtual std::vector<SampleAnswer> SamplePass(const std::vector<SampleQuery>& queries,
+                                                 const MonteCarloPass& pass) const;
+    virtual std::string PassKey() const;
 
     // Precomputed tables as files (`atmos bake`, `--load`): models with tables
     // override all three. Bake writes the tables of the last Prepare() to

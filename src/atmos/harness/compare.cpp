@@ -30,10 +30,17 @@ double SecondsSince(std::chrono::steady_clock::time_point t) {
 class LazyRenderer {
   public:
     LazyRenderer(std::string name, std::map<std::string, std::string> options,
-                 const CompareConfig& config, const RenderCache& cache)
-        : name_(std::move(name)), options_(std::move(options)), config_(config), cache_(cache) {
+                 const CompareConfig& config, const RenderCache& cache,
+                 const MonteCarloSettings& monte_carlo = MonteCarloSettings())
+        : name_(std::move(name)),
+          options_(std::move(options)),
+          config_(config),
+          cache_(cache),
+          monte_carlo_(monte_carlo) {
         key_.model = name_;
         key_.options = ResolvedModelOptions(name_, options_);
+        key_.monte_carlo = GetModelInfo(name_).capabilities.stochastic;
+        key_.mc = monte_carlo_;
         key_.atmosphere_json = AtmosphereToJson(config.atmosphere);
         key_.width = config.width;
         key_.height = config.height;
@@ -61,6 +68,7 @@ class LazyRenderer {
         request.height = config_.height;
         request.quantity = config_.quantity;
         request.show_progress = config_.show_progress;
+        request.monte_carlo = monte_carlo_;
         const auto start = std::chrono::steady_clock::now();
         model_->Render(request, &image);
         *seconds = SecondsSince(start);
@@ -77,6 +85,7 @@ class LazyRenderer {
     std::map<std::string, std::string> options_;
     const CompareConfig& config_;
     const RenderCache& cache_;
+    MonteCarloSettings monte_carlo_;
     RenderKey key_;
     std::unique_ptr<Model> model_;
     double prepare_seconds_ = 0.0;
@@ -218,27 +227,22 @@ CompareResult RunCompare(const CompareConfig& config) {
     // A Monte Carlo reference: two independent halves, averaged (the same
     // number of paths), whose difference measures its noise.
     const ModelInfo& reference_info = GetModelInfo(config.reference_model);
-    const std::map<std::string, std::string> reference_resolved =
-        ResolvedModelOptions(config.reference_model, config.reference_options);
-    const bool split_reference = !transmittance && reference_info.capabilities.stochastic &&
-                                 reference_resolved.count("spp") &&
-                                 reference_resolved.count("seed") &&
-                                 std::stoll(reference_resolved.at("spp")) >= 2;
-    std::map<std::string, std::string> half_a = config.reference_options;
-    std::map<std::string, std::string> half_b = config.reference_options;
+    const MonteCarloSettings& mc = config.reference_monte_carlo;
+    const bool split_reference =
+        !transmittance && reference_info.capabilities.stochastic && mc.spp >= 2;
+    MonteCarloSettings half_a = mc, half_b = mc;
     int64_t spp_a = 0, spp_b = 0;
     if (split_reference) {
-        const int64_t spp = std::stoll(reference_resolved.at("spp"));
-        const int64_t seed = std::stoll(reference_resolved.at("seed"));
-        spp_a = spp / 2;
-        spp_b = spp - spp_a;
-        half_a["spp"] = std::to_string(spp_a);
-        half_b["spp"] = std::to_string(spp_b);
-        half_a["seed"] = std::to_string(2 * seed + 1);
-        half_b["seed"] = std::to_string(2 * seed + 2);
+        spp_a = mc.spp / 2;
+        spp_b = mc.spp - spp_a;
+        half_a.spp = spp_a;
+        half_b.spp = spp_b;
+        half_a.seed = 2 * mc.seed + 1;
+        half_b.seed = 2 * mc.seed + 2;
     }
-    LazyRenderer reference(config.reference_model, half_a, config, cache);
-    LazyRenderer reference_b(config.reference_model, half_b, config, cache);
+    LazyRenderer reference(config.reference_model, config.reference_options, config, cache, half_a);
+    LazyRenderer reference_b(config.reference_model, config.reference_options, config, cache,
+                             half_b);
     std::vector<std::unique_ptr<LazyRenderer>> renderers;
     for (const ModelSpec& spec : specs) {
         renderers.push_back(std::make_unique<LazyRenderer>(spec.name, spec.options, config, cache));

@@ -31,6 +31,8 @@ struct CompareConfig {
     Quantity quantity = Quantity::kRadiance;
     std::string reference_model = "naive";
     std::map<std::string, std::string> reference_options;
+    // A Monte Carlo reference's estimate (spp, seed; split into halves, see CompareRow).
+    MonteCarloSettings reference_monte_carlo;
     std::string reference_note;  // how the reference was chosen (shown in the report)
     std::string atmosphere_name = "earth";
     AtmosphereParameters atmosphere;

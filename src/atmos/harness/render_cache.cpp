@@ -39,6 +39,10 @@ std::string RenderKeyText(const RenderKey& key) {
     os << "build " << BuildIdentity() << "\n";
     os << "model " << key.model << "\n";
     for (const auto& [name, value] : key.options) os << "option " << name << "=" << value << "\n";
+    if (key.monte_carlo) {
+        os << "monte-carlo spp=" << key.mc.spp << " seed=" << key.mc.seed
+           << " pass-spp=" << key.mc.pass_spp << "\n";
+    }
     os << "view " << key.view << "\n";
     os << "size " << key.width << "x" << key.height << "\n";
     os << "quantity " << QuantityName(key.quantity) << "\n";

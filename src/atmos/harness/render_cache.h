@@ -27,6 +27,8 @@ struct RenderKey {
     int width = 0;
     int height = 0;
     Quantity quantity = Quantity::kRadiance;
+    bool monte_carlo = false;  // a Monte Carlo model: `mc` determines the image too
+    MonteCarloSettings mc;
 };
 
 // A 64-bit FNV-1a hash of the running executable (/proc/self/exe), in hex;

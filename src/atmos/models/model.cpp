@@ -190,4 +190,17 @@ void Model::LoadBaked(const std::string&, const AtmosphereParameters&) {
     Fail("model ", Info().name, " has no precomputed tables to load");
 }
 
+void Model::RenderPass(const RenderRequest&, const MonteCarloPass&, Image*, Progress*) const {
+    Fail("model ", Info().name, " is not a Monte Carlo model: it renders no passes");
+}
+
+std::vector<SampleAnswer> Model::SamplePass(const std::vector<SampleQuery>&,
+                                            const MonteCarloPass&) const {
+    Fail("model ", Info().name, " is not a Monte Carlo model: it samples no passes");
+}
+
+std::string Model::PassKey() const {
+    Fail("model ", Info().name, " is not a Monte Carlo model: it has no pass key");
+}
+
 }  // namespace atmos

@@ -8,6 +8,7 @@
 
 #include "atmos/error.h"
 #include "base/rng.h"
+#include "render/progressive.h"
 
 // GCC 12 reports a false -Wfree-nonheap-object in the inlined std::vector
 // destructors of Train() (a known GCC 12 false positive with -O3).
@@ -297,8 +298,13 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
         sq[i].mu_s = kNeuralMinMuS + (1.0 - kNeuralMinMuS) * rng.Uniform();
         sq[i].azimuth_deg = 180.0 * rng.Uniform();
     }
-    const std::vector<SampleAnswer> ta = reference.Sample(tq);
-    const std::vector<SampleAnswer> sa = reference.Sample(sq);
+    auto sample = [&](const std::vector<SampleQuery>& queries) {
+        return reference.Info().capabilities.stochastic
+                   ? SampleMonteCarlo(reference, queries, o.reference_monte_carlo)
+                   : reference.Sample(queries);
+    };
+    const std::vector<SampleAnswer> ta = sample(tq);
+    const std::vector<SampleAnswer> sa = sample(sq);
     const auto t1 = std::chrono::steady_clock::now();
 
     DataSet td, sd;

@@ -40,6 +40,8 @@ struct NeuralFitOptions {
     double final_learning_rate = 0.01;
     double holdout = 0.1;  // fraction of samples held out
     uint64_t seed = 1;
+    // A Monte Carlo reference's estimate per query (spp, seed).
+    MonteCarloSettings reference_monte_carlo;
 };
 
 struct NeuralNetFitReport {

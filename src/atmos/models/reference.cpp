@@ -2,10 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include <chrono>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
@@ -95,24 +92,15 @@ const OptionTable<ReferenceOptions>& ReferenceModel::OptionRows() {
                     "spectral: all channels per path (spectral tracking, forced first collision, "
                     "ratio-tracked sun); thesis: the thesis's estimator (one random channel per "
                     "path, delta tracking, uniform directions), kept as a baseline")
-            .Integer("spp", &O::spp, 1, 1e9, "", "paths per pixel (per query for sample)")
-            .Integer("seed", &O::seed, 0, 4294967295.0, "", "random seed")
             .Integer("max-order", &O::max_order, 0, 1e6, "",
                      "highest scattering order (volume or ground vertices); 0: unlimited")
             .Integer("shells", &O::shells, 1, kMaxReferenceShells, "",
-                     "altitude shells of the majorant (1: one global majorant)")
-            .Integer("pass-spp", &O::pass_spp, 0, 1e9, "",
-                     "paths per pixel per pass (checkpoint and variance granularity); 0: spp/8 "
-                     "in [1, 64]. Set it explicitly to extend a checkpointed render to more spp "
-                     "with --resume");
+                     "altitude shells of the majorant (1: one global majorant)");
     return table;
 }
 
 ReferenceModel::ReferenceModel(const ReferenceOptions& options) : info_(StaticInfo()) {
-    spp_ = options.spp;
-    pass_spp_ = options.pass_spp;
     shell_count_ = options.shells;
-    evaluator_.seed = options.seed;
     evaluator_.max_order = options.max_order;
     evaluator_.spectral = options.spectral;
     sun_disc_light_ = options.sun_disc_light != 0;
@@ -125,152 +113,39 @@ void ReferenceModel::Prepare(const AtmosphereParameters& atmosphere) {
     evaluator_.shells = BuildMajorantShells(atmosphere, shell_count_);
 }
 
-namespace {
-
-// Everything that determines a render's passes; a checkpoint resumes only the
-// same render.
-nlohmann::json CheckpointKey(const RenderRequest& request, const ReferenceEvaluator& e,
-                             int pass_spp) {
+std::string ReferenceModel::PassKey() const {
     nlohmann::json key;
-    key["format"] = "atmos-reference-checkpoint-1";
-    key["view"] = request.view.name;
-    key["camera"] = {request.view.camera.position.x,    request.view.camera.position.y,
-                     request.view.camera.position.z,    request.view.camera.forward.x,
-                     request.view.camera.forward.y,     request.view.camera.forward.z,
-                     request.view.camera.tan_half_fov_y};
-    key["sun"] = {request.view.sun_direction.x, request.view.sun_direction.y,
-                  request.view.sun_direction.z};
-    key["irradiance"] = request.view.sun_irradiance;
-    key["width"] = request.width;
-    key["height"] = request.height;
-    key["quantity"] = QuantityName(request.quantity);
-    key["sun_disc"] = request.sun_disc;
-    key["seed"] = e.seed;
-    key["max_order"] = e.max_order;
-    key["estimator"] = e.spectral ? "spectral" : "thesis";
-    key["sun_cone_cos"] = e.sun_cone_cos;
-    key["shells"] = e.shells.count;
-    key["pass_spp"] = pass_spp;
-    key["atmosphere"] = nlohmann::json::parse(AtmosphereToJson(e.atm));
-    return key;
+    key["max_order"] = evaluator_.max_order;
+    key["estimator"] = evaluator_.spectral ? "spectral" : "thesis";
+    key["sun_cone_cos"] = evaluator_.sun_cone_cos;
+    key["shells"] = evaluator_.shells.count;
+    key["atmosphere"] = nlohmann::json::parse(AtmosphereToJson(evaluator_.atm));
+    return key.dump();
 }
 
-}  // namespace
-
-void ReferenceModel::Render(const RenderRequest& request, Image* out) const {
+void ReferenceModel::RenderPass(const RenderRequest& request, const MonteCarloPass& pass,
+                                Image* out, Progress* progress) const {
     const PixelSetup setup = MakePixelSetup(request, evaluator_.atm);
     out->Resize(request.width, request.height);
+    ReferenceEvaluator e = evaluator_;
+    e.seed = pass.seed;
     if (request.quantity == Quantity::kTransmittance) {
-        // Deterministic: one pass with one sample is enough (T does not depend on it).
-        ReferenceEvaluator e = evaluator_;
+        // Deterministic: no paths needed (T does not depend on them).
         e.sample_count = 0;
-        RenderImage(e, setup, out->View(), request.show_progress);
-        if (request.variance) request.variance->Resize(request.width, request.height);
-        return;
-    }
-    // Passes of pass_spp samples (auto: 8 passes, so the variance of the mean
-    // can be estimated from the pass means).
-    const int pass_spp = pass_spp_ > 0 ? pass_spp_ : std::clamp(spp_ / 8, 1, 64);
-    const int passes = (spp_ + pass_spp - 1) / pass_spp;
-    const size_t n = out->size();
-    Image sum(request.width, request.height), sum_sq(request.width, request.height);
-    int passes_done = 0;
-    int samples_done = 0;
-
-    const nlohmann::json key = CheckpointKey(request, evaluator_, pass_spp);
-    const std::string stem = request.checkpoint;
-    if (!stem.empty() && request.resume && std::filesystem::exists(stem + ".json")) {
-        std::ifstream f(stem + ".json");
-        nlohmann::json saved;
-        try {
-            f >> saved;
-        } catch (const std::exception& ex) {
-            Fail("checkpoint '", stem, ".json' is unreadable: ", ex.what());
-        }
-        if (!saved.contains("key") || saved["key"] != key) {
-            Fail("checkpoint '", stem,
-                 ".json' was made for a different render (view, size, seed, atmosphere, "
-                 "pass size or order differ); remove it or drop --resume");
-        }
-        passes_done = saved.value("passes_done", 0);
-        samples_done = saved.value("samples_done", 0);
-        if (passes_done > passes || samples_done > spp_) {
-            Fail("checkpoint '", stem, "' already holds ", samples_done,
-                 " samples per pixel, more than --spp ", spp_);
-        }
-        sum = ReadImage(stem + ".sum.exr");
-        sum_sq = ReadImage(stem + ".sumsq.exr");
-        if (sum.width() != request.width || sum.height() != request.height ||
-            sum_sq.width() != request.width || sum_sq.height() != request.height) {
-            Fail("checkpoint '", stem, "' images do not match the render size");
-        }
-    }
-    auto save_checkpoint = [&]() {
-        if (stem.empty()) return;
-        const std::filesystem::path parent = std::filesystem::path(stem).parent_path();
-        if (!parent.empty()) std::filesystem::create_directories(parent);
-        WriteImage(sum, stem + ".sum.exr");
-        WriteImage(sum_sq, stem + ".sumsq.exr");
-        nlohmann::json saved;
-        saved["key"] = key;
-        saved["passes_done"] = passes_done;
-        saved["samples_done"] = samples_done;
-        const std::string tmp = stem + ".json.tmp";
-        {
-            std::ofstream f(tmp);
-            f << saved.dump(1) << "\n";
-            if (!f) Fail("cannot write checkpoint '", tmp, "'");
-        }
-        std::filesystem::rename(tmp, stem + ".json");
-    };
-
-    const int64_t pixels = static_cast<int64_t>(request.width) * request.height;
-    Progress progress("reference", pixels * std::max(passes - passes_done, 1),
-                      request.show_progress);
-    Image pass(request.width, request.height);
-    auto last_save = std::chrono::steady_clock::now();
-    for (int p = passes_done; p < passes; ++p) {
-        ReferenceEvaluator e = evaluator_;
-        e.sample_begin = p * pass_spp;
-        e.sample_count = std::min(pass_spp, spp_ - e.sample_begin);
+    } else {
+        e.sample_begin = pass.first_sample;
+        e.sample_count = pass.samples;
         e.need_transmittance = request.sun_disc;  // the only use of T in a radiance pass
-        RenderImage(e, setup, pass.View(), &progress);
-        // Weighted by the pass's sample count so a short last pass counts right.
-        const float wgt = static_cast<float>(e.sample_count);
-        for (size_t i = 0; i < n; ++i) {
-            const float v = pass.data()[i];
-            sum.data()[i] += wgt * v;
-            sum_sq.data()[i] += wgt * v * v;
-        }
-        ++passes_done;
-        samples_done += e.sample_count;
-        const auto now = std::chrono::steady_clock::now();
-        if (std::chrono::duration<double>(now - last_save).count() > 10.0 || p + 1 == passes) {
-            save_checkpoint();
-            last_save = now;
-        }
     }
-    // Mean, and the variance of the mean from the pass means (batch means):
-    // Var(mean) = (E[v^2] - mean^2) / (passes - 1), weights by sample count.
-    if (request.variance) request.variance->Resize(request.width, request.height);
-    const float inv = 1.0f / static_cast<float>(std::max(samples_done, 1));
-    for (size_t i = 0; i < n; ++i) {
-        const float mean = sum.data()[i] * inv;
-        out->data()[i] = mean;
-        if (request.variance) {
-            const float second = sum_sq.data()[i] * inv;
-            const float var = passes_done > 1 ? std::max(second - mean * mean, 0.0f) /
-                                                    static_cast<float>(passes_done - 1)
-                                              : 0.0f;
-            request.variance->data()[i] = var;
-        }
-    }
+    RenderImage(e, setup, out->View(), progress);
 }
 
-std::vector<SampleAnswer> ReferenceModel::Sample(const std::vector<SampleQuery>& queries) const {
+std::vector<SampleAnswer> ReferenceModel::SamplePass(const std::vector<SampleQuery>& queries,
+                                                     const MonteCarloPass& pass) const {
     ReferenceEvaluator e = evaluator_;
-    e.sample_begin = 0;
-    e.sample_count = spp_;
+    e.seed = pass.seed;
+    e.sample_begin = pass.first_sample;
+    e.sample_count = pass.samples;
     return SampleAll(e, e.atm.bottom_radius, queries);
 }
 

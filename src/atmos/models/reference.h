@@ -63,6 +63,7 @@
 #include "physics/phase.h"
 #include "physics/sampling.h"
 #include "physics/transmittance.h"
+#include "render/progressive.h"
 #include "render/render.h"
 
 namespace atmos {
@@ -94,8 +95,8 @@ struct ReferenceEvaluator {
     AtmosphereParameters atm;
     MajorantShells shells;
     uint64_t seed = 0;
-    int sample_begin = 0;  // the samples [sample_begin, sample_begin + sample_count)
-    int sample_count = 1;
+    int64_t sample_begin = 0;  // the samples [sample_begin, sample_begin + sample_count)
+    int64_t sample_count = 1;
     // Whether the view ray's transmittance (1024-interval integral, ~20-40 us
     // per pixel on the CPU) is computed: only the sun's disc, the transmittance
     // output and `sample` use it; a radiance pass without the disc leaves it 1.
@@ -445,7 +446,7 @@ struct ReferenceEvaluator {
         const double forced =
             reflective_end ? 0.0 : MajorantDepth(start, dir, shell, seg.t_end - seg.t_start);
         Vec3d sky, ground;
-        for (int s = 0; s < sample_count; ++s) {
+        for (int64_t s = 0; s < sample_count; ++s) {
             Rng rng(seed, key, static_cast<uint64_t>(sample_begin + s));
             if (spectral) {
                 TracePath(start, dir, shell, sun, rng, forced, seg.t_end - seg.t_start, &sky,
@@ -466,14 +467,13 @@ struct ReferenceEvaluator {
 struct ReferenceOptions {
     int sun_disc_light = 0;  // 1: light from the sun's disc
     bool spectral = true;    // estimator: spectral (true) or the thesis's (false)
-    int spp = 64;
-    uint64_t seed = 0;
-    int max_order = 0;  // 0: unlimited
-    int shells = 48;    // altitude shells of the majorant
-    int pass_spp = 0;   // 0: spp/8 in [1, 64]
+    int max_order = 0;       // 0: unlimited
+    int shells = 48;         // altitude shells of the majorant
 };
 
-class ReferenceModel : public Model {
+// The host side: one pass is the evaluator with the pass's seed and samples;
+// the passes, checkpoints and variance are the progressive driver's.
+class ReferenceModel : public MonteCarloModel {
   public:
     using Options = ReferenceOptions;
     static const OptionTable<ReferenceOptions>& OptionRows();
@@ -481,16 +481,16 @@ class ReferenceModel : public Model {
     static ModelInfo StaticInfo();
     const ModelInfo& Info() const override { return info_; }
     void Prepare(const AtmosphereParameters& atmosphere) override;
-    void Render(const RenderRequest& request, Image* out) const override;
-    std::vector<SampleAnswer> Sample(const std::vector<SampleQuery>& queries) const override;
+    void RenderPass(const RenderRequest& request, const MonteCarloPass& pass, Image* out,
+                    Progress* progress) const override;
+    std::vector<SampleAnswer> SamplePass(const std::vector<SampleQuery>& queries,
+                                         const MonteCarloPass& pass) const override;
+    std::string PassKey() const override;
     const ReferenceEvaluator& evaluator() const { return evaluator_; }
-    int spp() const { return spp_; }
 
   private:
     ModelInfo info_;
     ReferenceEvaluator evaluator_;
-    int spp_ = 64;
-    int pass_spp_ = 0;  // 0: auto
     int shell_count_ = 48;
     bool sun_disc_light_ = false;
 };

@@ -1,0 +1,329 @@
+// atmos: the progressive renderer of Monte Carlo models (see progressive.h).
+#include "render/progressive.h"
+
+#include <nlohmann/json.hpp>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "atmos/error.h"
+#include "base/progress.h"
+
+namespace atmos {
+
+namespace {
+
+void RequireMonteCarlo(const Model& model) {
+    if (!model.Info().capabilities.stochastic) {
+        Fail("model ", model.Info().name,
+             " is not a Monte Carlo model: --spp, --seed and --pass-spp do not apply to it");
+    }
+}
+
+void CheckSettings(const MonteCarloSettings& mc) {
+    if (mc.spp < 1) Fail("Monte Carlo render: spp must be at least 1, got ", mc.spp);
+    if (mc.pass_spp < 0) Fail("Monte Carlo render: pass spp must be >= 0, got ", mc.pass_spp);
+}
+
+// Everything that determines a render's passes; a checkpoint resumes only the
+// same render.
+nlohmann::json CheckpointKey(const Model& model, const RenderRequest& request, int64_t pass_spp) {
+    nlohmann::json key;
+    key["format"] = "atmos-checkpoint-2";
+    key["model"] = model.Info().name;
+    key["model_key"] = nlohmann::json::parse(model.PassKey());
+    key["view"] = request.view.name;
+    key["camera"] = {request.view.camera.position.x,    request.view.camera.position.y,
+                     request.view.camera.position.z,    request.view.camera.forward.x,
+                     request.view.camera.forward.y,     request.view.camera.forward.z,
+                     request.view.camera.tan_half_fov_y};
+    key["sun"] = {request.view.sun_direction.x, request.view.sun_direction.y,
+                  request.view.sun_direction.z};
+    key["irradiance"] = request.view.sun_irradiance;
+    key["width"] = request.width;
+    key["height"] = request.height;
+    key["quantity"] = QuantityName(request.quantity);
+    key["sun_disc"] = request.sun_disc;
+    key["seed"] = request.monte_carlo.seed;
+    key["pass_spp"] = pass_spp;
+    return key;
+}
+
+// A checkpoint is one file, STEM.bin, committed atomically: written to
+// STEM.bin.tmp, fsync'ed, renamed over STEM.bin, its directory fsync'ed. A kill
+// at any point leaves the previous checkpoint (or none) intact. Layout (host
+// byte order): the 8 bytes "atmosck2", the header's length (uint64), the
+// header (JSON: the render's key, width, height, passes_done, samples_done),
+// the sums and the sums of squares (float32, width x height x 3 each), and a
+// 64-bit FNV-1a checksum of everything before it.
+constexpr char kCheckpointMagic[8] = {'a', 't', 'm', 'o', 's', 'c', 'k', '2'};
+
+uint64_t Fnv1a(const char* data, size_t size, uint64_t h = 14695981039346656037ull) {
+    for (size_t i = 0; i < size; ++i) {
+        h ^= static_cast<unsigned char>(data[i]);
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+struct CheckpointState {
+    int64_t passes_done = 0;
+    int64_t samples_done = 0;
+    Image sum, sum_sq;
+};
+
+void WriteAll(int fd, const std::string& bytes, const std::string& path) {
+    size_t done = 0;
+    while (done < bytes.size()) {
+        const ssize_t w = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) {
+            const int err = errno;
+            ::close(fd);
+            Fail("cannot write checkpoint '", path, "': ", std::strerror(err));
+        }
+        done += static_cast<size_t>(w);
+    }
+}
+
+void WriteCheckpoint(const std::string& path, const nlohmann::json& key,
+                     const CheckpointState& state) {
+    nlohmann::json header;
+    header["key"] = key;
+    header["width"] = state.sum.width();
+    header["height"] = state.sum.height();
+    header["passes_done"] = state.passes_done;
+    header["samples_done"] = state.samples_done;
+    const std::string text = header.dump();
+    const uint64_t header_size = text.size();
+    const size_t image_bytes = state.sum.size() * sizeof(float);
+    std::string bytes;
+    bytes.reserve(sizeof kCheckpointMagic + 8 + text.size() + 2 * image_bytes + 8);
+    bytes.append(kCheckpointMagic, sizeof kCheckpointMagic);
+    bytes.append(reinterpret_cast<const char*>(&header_size), sizeof header_size);
+    bytes.append(text);
+    bytes.append(reinterpret_cast<const char*>(state.sum.data()), image_bytes);
+    bytes.append(reinterpret_cast<const char*>(state.sum_sq.data()), image_bytes);
+    const uint64_t checksum = Fnv1a(bytes.data(), bytes.size());
+    bytes.append(reinterpret_cast<const char*>(&checksum), sizeof checksum);
+
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+    const std::string tmp = path + ".tmp";
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) Fail("cannot write checkpoint '", tmp, "': ", std::strerror(errno));
+    WriteAll(fd, bytes, tmp);
+    if (::fsync(fd) != 0 || ::close(fd) != 0) {
+        Fail("cannot write checkpoint '", tmp, "': ", std::strerror(errno));
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        Fail("cannot commit checkpoint '", path, "': ", std::strerror(errno));
+    }
+    const std::string dir = parent.empty() ? "." : parent.string();
+    const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dfd >= 0) {
+        ::fsync(dfd);
+        ::close(dfd);
+    }
+}
+
+// Reads and verifies a checkpoint of the render `key` (passes of pass_spp,
+// spp in all): one atmos::Error for anything that does not add up.
+CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& key, int width,
+                               int height, int64_t spp, int64_t pass_spp) {
+    auto damaged = [&](const std::string& why) {
+        Fail("checkpoint '", path, "' is damaged (", why,
+             "); remove it or drop --resume to start over");
+    };
+    std::ifstream f(path, std::ios::binary);
+    if (!f) Fail("cannot read checkpoint '", path, "'");
+    const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    const size_t fixed = sizeof kCheckpointMagic + 8 + 8;
+    if (bytes.size() < fixed || bytes.compare(0, 8, kCheckpointMagic, 8) != 0) {
+        damaged("not an atmos checkpoint, or truncated");
+    }
+    uint64_t header_size = 0, checksum = 0;
+    std::memcpy(&header_size, bytes.data() + 8, sizeof header_size);
+    std::memcpy(&checksum, bytes.data() + bytes.size() - 8, sizeof checksum);
+    if (header_size > bytes.size() - fixed) damaged("truncated header");
+    if (Fnv1a(bytes.data(), bytes.size() - 8) != checksum) damaged("checksum mismatch");
+    nlohmann::json header;
+    try {
+        header = nlohmann::json::parse(bytes.substr(16, header_size));
+    } catch (const std::exception&) {
+        damaged("unreadable header");
+    }
+    if (!header.contains("key") || header["key"] != key) {
+        Fail("checkpoint '", path,
+             "' was made for a different render (model, view, size, seed, atmosphere, pass size "
+             "or options differ); remove it or drop --resume");
+    }
+    CheckpointState s;
+    try {
+        if (header.at("width").get<int>() != width || header.at("height").get<int>() != height) {
+            damaged("its size is not the render's");
+        }
+        s.passes_done = header.at("passes_done").get<int64_t>();
+        s.samples_done = header.at("samples_done").get<int64_t>();
+    } catch (const nlohmann::json::exception&) {
+        damaged("header fields missing");
+    }
+    const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height) * 3;
+    if (bytes.size() != fixed + header_size + 2 * n * sizeof(float)) damaged("wrong size");
+    // Every pass but a last one holds pass_spp samples.
+    const bool counts_ok = s.passes_done >= 0 && s.samples_done >= 0 &&
+                           s.samples_done <= s.passes_done * pass_spp &&
+                           (s.passes_done == 0 || s.samples_done > (s.passes_done - 1) * pass_spp);
+    if (!counts_ok) damaged("its pass and sample counts disagree");
+    if (s.samples_done > spp) {
+        Fail("checkpoint '", path, "' already holds ", s.samples_done,
+             " samples per pixel, more than --spp ", spp);
+    }
+    s.sum.Resize(width, height);
+    s.sum_sq.Resize(width, height);
+    std::memcpy(s.sum.data(), bytes.data() + 16 + header_size, n * sizeof(float));
+    std::memcpy(s.sum_sq.data(), bytes.data() + 16 + header_size + n * sizeof(float),
+                n * sizeof(float));
+    for (size_t i = 0; i < n; ++i) {
+        if (!std::isfinite(s.sum.data()[i]) || !std::isfinite(s.sum_sq.data()[i]) ||
+            s.sum_sq.data()[i] < 0.0f) {
+            damaged("a sum is not finite");
+        }
+    }
+    return s;
+}
+
+}  // namespace
+
+int64_t PassSpp(const MonteCarloSettings& mc) {
+    return mc.pass_spp > 0 ? mc.pass_spp : std::clamp<int64_t>(mc.spp / 8, 1, 64);
+}
+
+MonteCarloSettings MakeMonteCarloSettings(int64_t spp, int64_t seed, int64_t pass_spp,
+                                          const char* spp_flag, const char* seed_flag,
+                                          const char* pass_flag) {
+    if (spp < 1) Fail(spp_flag, " must be at least 1, got ", spp);
+    if (seed < 0 || seed > 4294967295ll) {
+        Fail(seed_flag, " must be in [0, 4294967295], got ", seed);
+    }
+    if (pass_spp < 0) Fail(pass_flag, " must be >= 0 (0: spp/8 in [1, 64]), got ", pass_spp);
+    MonteCarloSettings mc;
+    mc.spp = spp;
+    mc.seed = static_cast<uint64_t>(seed);
+    mc.pass_spp = pass_spp;
+    return mc;
+}
+
+std::vector<SampleAnswer> SampleMonteCarlo(const Model& model,
+                                           const std::vector<SampleQuery>& queries,
+                                           const MonteCarloSettings& mc) {
+    RequireMonteCarlo(model);
+    CheckSettings(mc);
+    MonteCarloPass pass;
+    pass.seed = mc.seed;
+    pass.first_sample = 0;
+    pass.samples = mc.spp;
+    return model.SamplePass(queries, pass);
+}
+
+void RenderProgressive(const Model& model, const RenderRequest& request, Image* out) {
+    RequireMonteCarlo(model);
+    const MonteCarloSettings& mc = request.monte_carlo;
+    CheckSettings(mc);
+    if (request.quantity == Quantity::kTransmittance) {
+        Progress progress(model.Info().name, static_cast<int64_t>(request.width) * request.height,
+                          request.show_progress);
+        MonteCarloPass pass;
+        pass.seed = mc.seed;
+        pass.samples = mc.spp;
+        model.RenderPass(request, pass, out, &progress);
+        if (request.variance) request.variance->Resize(request.width, request.height);
+        return;
+    }
+    // Passes of pass_spp samples (auto: 8 passes, so the variance of the mean
+    // can be estimated from the pass means).
+    const int64_t spp = mc.spp;
+    const int64_t pass_spp = PassSpp(mc);
+    const int64_t passes = (spp + pass_spp - 1) / pass_spp;
+    out->Resize(request.width, request.height);
+    const size_t n = out->size();
+
+    const std::string stem = request.checkpoint;
+    const std::string path = stem + ".bin";
+    const nlohmann::json key =
+        stem.empty() ? nlohmann::json() : CheckpointKey(model, request, pass_spp);
+    CheckpointState state;
+    state.sum.Resize(request.width, request.height);
+    state.sum_sq.Resize(request.width, request.height);
+    if (!stem.empty() && request.resume) {
+        if (std::filesystem::exists(path)) {
+            state = ReadCheckpoint(path, key, request.width, request.height, spp, pass_spp);
+        } else if (std::filesystem::exists(stem + ".json")) {
+            Fail("checkpoint '", stem,
+                 ".json' is in an older atmos format (sums in EXR files); remove it or drop "
+                 "--resume");
+        }
+    }
+    Image& sum = state.sum;
+    Image& sum_sq = state.sum_sq;
+    int64_t& passes_done = state.passes_done;
+    int64_t& samples_done = state.samples_done;
+    auto save_checkpoint = [&]() {
+        if (!stem.empty()) WriteCheckpoint(path, key, state);
+    };
+
+    const int64_t pixels = static_cast<int64_t>(request.width) * request.height;
+    Progress progress(model.Info().name, pixels * std::max<int64_t>(passes - passes_done, 1),
+                      request.show_progress);
+    Image pass_image;
+    auto last_save = std::chrono::steady_clock::now();
+    for (int64_t p = passes_done; p < passes; ++p) {
+        MonteCarloPass pass;
+        pass.seed = mc.seed;
+        pass.first_sample = p * pass_spp;
+        pass.samples = std::min(pass_spp, spp - pass.first_sample);
+        model.RenderPass(request, pass, &pass_image, &progress);
+        // Weighted by the pass's sample count so a short last pass counts right.
+        const float wgt = static_cast<float>(pass.samples);
+        for (size_t i = 0; i < n; ++i) {
+            const float v = pass_image.data()[i];
+            sum.data()[i] += wgt * v;
+            sum_sq.data()[i] += wgt * v * v;
+        }
+        ++passes_done;
+        samples_done += pass.samples;
+        const auto now = std::chrono::steady_clock::now();
+        if (std::chrono::duration<double>(now - last_save).count() > 10.0 || p + 1 == passes) {
+            save_checkpoint();
+            last_save = now;
+        }
+    }
+    // Mean, and the variance of the mean from the pass means (batch means):
+    // Var(mean) = (E[v^2] - mean^2) / (passes - 1), weights by sample count.
+    if (request.variance) request.variance->Resize(request.width, request.height);
+    const float inv = 1.0f / static_cast<float>(std::max<int64_t>(samples_done, 1));
+    for (size_t i = 0; i < n; ++i) {
+        const float mean = sum.data()[i] * inv;
+        out->data()[i] = mean;
+        if (request.variance) {
+            const float second = sum_sq.data()[i] * inv;
+            const float var = passes_done > 1 ? std::max(second - mean * mean, 0.0f) /
+                                                    static_cast<float>(passes_done - 1)
+                                              : 0.0f;
+            request.variance->data()[i] = var;
+        }
+    }
+}
+
+}  // namespace atmos

@@ -1,0 +1,278 @@
+// The progressive driver (render/progressive.h) for any model that declares
+// itself Monte Carlo: a test-only stochastic model whose pixels are means of
+// uniform random numbers, passes weighted by their counts, checkpoint and
+// resume, the variance, and one clear error for models that are not Monte Carlo.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <memory>
+
+#include "atmos/atmosphere.h"
+#include "atmos/error.h"
+#include "atmos/model.h"
+#include "base/progress.h"
+#include "base/rng.h"
+#include "render/progressive.h"
+
+namespace atmos {
+namespace {
+
+// Pixel (x, y), channel c of a pass: the mean of Rng(seed, pixel, sample)'s c-th
+// uniform over the pass's samples. `stochastic` is its capability flag; the
+// class is a Monte Carlo model either way (the driver must go by the flag).
+class CoinModel : public Model {
+  public:
+    explicit CoinModel(bool stochastic) {
+        info_.name = "coin";
+        info_.capabilities.stochastic = stochastic;
+    }
+    const ModelInfo& Info() const override { return info_; }
+    void Prepare(const AtmosphereParameters&) override {}
+    void Render(const RenderRequest& request, Image* out) const override {
+        RenderProgressive(*this, request, out);
+    }
+    std::vector<SampleAnswer> Sample(const std::vector<SampleQuery>& queries) const override {
+        return SampleMonteCarlo(*this, queries, MonteCarloSettings());
+    }
+    void RenderPass(const RenderRequest& request, const MonteCarloPass& pass, Image* out,
+                    Progress* progress) const override {
+        ++passes_rendered;
+        out->Resize(request.width, request.height);
+        for (int y = 0; y < request.height; ++y) {
+            for (int x = 0; x < request.width; ++x) {
+                out->Set(x, y, Rgb(Mean(pass, static_cast<uint64_t>(y * request.width + x))));
+            }
+        }
+        if (progress) progress->Add(static_cast<int64_t>(request.width) * request.height);
+    }
+    std::vector<SampleAnswer> SamplePass(const std::vector<SampleQuery>& queries,
+                                         const MonteCarloPass& pass) const override {
+        std::vector<SampleAnswer> answers(queries.size());
+        for (size_t i = 0; i < queries.size(); ++i) answers[i].radiance = Rgb(Mean(pass, i));
+        return answers;
+    }
+    std::string PassKey() const override { return "{\"coin\": 1}"; }
+
+    static Vec3d Mean(const MonteCarloPass& pass, uint64_t key) {
+        Vec3d sum(0.0);
+        for (int64_t s = pass.first_sample; s < pass.first_sample + pass.samples; ++s) {
+            Rng rng(pass.seed, key, static_cast<uint64_t>(s));
+            for (int c = 0; c < 3; ++c) sum[c] += rng.Uniform();
+        }
+        return sum / static_cast<double>(pass.samples);
+    }
+
+    mutable int passes_rendered = 0;
+
+  private:
+    ModelInfo info_;
+};
+
+RenderRequest CoinRequest(int64_t spp, int64_t pass_spp) {
+    RenderRequest r;
+    r.view = GetView("ground-noon", EarthAtmosphere());
+    r.width = 5;
+    r.height = 3;
+    r.show_progress = false;
+    r.monte_carlo.spp = spp;
+    r.monte_carlo.seed = 11;
+    r.monte_carlo.pass_spp = pass_spp;
+    return r;
+}
+
+std::filesystem::path TestDir(const char* name) {
+    const char* env = std::getenv("ATMOS_TEST_TMP");
+    const std::filesystem::path dir =
+        (env ? std::filesystem::path(env) : std::filesystem::temp_directory_path() / "atmos_test") /
+        name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+TEST(Progressive, PassesOfAnyMonteCarloModelWeightedByTheirCounts) {
+    const CoinModel model(true);
+    RenderRequest request = CoinRequest(10, 4);  // passes of 4, 4 and 2 samples
+    Image image, variance;
+    request.variance = &variance;
+    model.Render(request, &image);
+    EXPECT_EQ(model.passes_rendered, 3);
+    ASSERT_EQ(variance.size(), image.size());
+    for (int y = 0; y < 3; ++y) {
+        for (int x = 0; x < 5; ++x) {
+            const uint64_t key = static_cast<uint64_t>(y * 5 + x);
+            MonteCarloPass all;
+            all.seed = 11;
+            all.samples = 10;
+            const Vec3d mean = CoinModel::Mean(all, key);
+            // Batch means: sum_p n_p (m_p - mean)^2 / (N (passes - 1)).
+            Vec3d var(0.0);
+            for (int64_t first : {0, 4, 8}) {
+                MonteCarloPass p = all;
+                p.first_sample = first;
+                p.samples = first == 8 ? 2 : 4;
+                const Vec3d d = CoinModel::Mean(p, key) - mean;
+                var += d * d * static_cast<double>(p.samples) / (10.0 * 2.0);
+            }
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_NEAR(image.Get(x, y)[c], mean[c], 1e-6);
+                EXPECT_NEAR(variance.Get(x, y)[c], var[c], 1e-6);
+            }
+        }
+    }
+    // The default pass size: spp / 8 in [1, 64].
+    EXPECT_EQ(PassSpp(CoinRequest(64, 0).monte_carlo), 8);
+    EXPECT_EQ(PassSpp(CoinRequest(5, 0).monte_carlo), 1);
+    EXPECT_EQ(PassSpp(CoinRequest(4096, 0).monte_carlo), 64);
+    EXPECT_EQ(PassSpp(CoinRequest(4096, 3).monte_carlo), 3);
+}
+
+TEST(Progressive, ResumesACheckpointOfAnyMonteCarloModel) {
+    const CoinModel model(true);
+    Image full;
+    model.Render(CoinRequest(12, 3), &full);
+    const std::filesystem::path dir = TestDir("progressive_resume");
+    RenderRequest request = CoinRequest(6, 3);
+    request.checkpoint = (dir / "coin").string();
+    Image partial;
+    model.Render(request, &partial);
+    request.monte_carlo.spp = 12;
+    request.resume = true;
+    Image resumed;
+    const int before = model.passes_rendered;
+    model.Render(request, &resumed);
+    EXPECT_EQ(model.passes_rendered - before, 2);  // passes 3 and 4 only
+    ASSERT_EQ(resumed.size(), full.size());
+    EXPECT_EQ(std::memcmp(resumed.data(), full.data(), full.size() * sizeof(float)), 0);
+    // Another seed or pass size is another render: refused.
+    request.monte_carlo.seed = 12;
+    EXPECT_THROW(model.Render(request, &resumed), Error);
+    request.monte_carlo.seed = 11;
+    request.monte_carlo.pass_spp = 4;
+    EXPECT_THROW(model.Render(request, &resumed), Error);
+}
+
+TEST(Progressive, ModelsThatAreNotMonteCarloFailClearly) {
+    // The same class without the capability flag: the driver refuses it.
+    const CoinModel flagless(false);
+    Image image;
+    try {
+        flagless.Render(CoinRequest(4, 0), &image);
+        ADD_FAILURE() << "rendered a model that is not Monte Carlo";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("coin is not a Monte Carlo model"), std::string::npos)
+            << e.what();
+    }
+    EXPECT_EQ(flagless.passes_rendered, 0);
+    EXPECT_THROW(SampleMonteCarlo(flagless, {SampleQuery()}, MonteCarloSettings()), Error);
+    // A registered deterministic model.
+    std::unique_ptr<Model> naive = CreateModel("naive");
+    EXPECT_THROW(RenderProgressive(*naive, CoinRequest(4, 0), &image), Error);
+    EXPECT_THROW(SampleMonteCarlo(*naive, {SampleQuery()}, MonteCarloSettings()), Error);
+    EXPECT_THROW(naive->RenderPass(CoinRequest(4, 0), MonteCarloPass(), &image, nullptr), Error);
+    // Monte Carlo models take no spp / seed / pass-spp options any more.
+    EXPECT_THROW(CreateModel("reference", {{"spp", "4"}}), Error);
+    EXPECT_THROW(CreateModel("reference", {{"seed", "4"}}), Error);
+    EXPECT_THROW(CreateModel("reference", {{"pass-spp", "4"}}), Error);
+}
+
+TEST(Progressive, SettingsAreValidatedWithOneClearError) {
+    EXPECT_EQ(MakeMonteCarloSettings(1, 4294967295ll, 0).seed, 4294967295ull);
+    EXPECT_EQ(MakeMonteCarloSettings(7, 3, 2).spp, 7);
+    for (const auto& [spp, seed, pass, needle] :
+         {std::make_tuple(0, 0, 0, "--spp must be at least 1"),
+          std::make_tuple(-3, 0, 0, "--spp must be at least 1"),
+          std::make_tuple(1, -1, 0, "--seed must be in [0, 4294967295]"),
+          std::make_tuple(1, 1, -1, "--pass-spp must be >= 0")}) {
+        try {
+            MakeMonteCarloSettings(spp, seed, pass);
+            ADD_FAILURE() << needle;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_THROW(MakeMonteCarloSettings(1, 4294967296ll, 0), Error);
+    // The driver itself refuses an empty render.
+    const CoinModel model(true);
+    Image image;
+    EXPECT_THROW(model.Render(CoinRequest(0, 0), &image), Error);
+    EXPECT_THROW(model.Render(CoinRequest(4, -1), &image), Error);
+}
+
+// Issue 18 item 1: --resume verifies what it reads. A truncated or damaged
+// checkpoint, counts that disagree, or a sum that is not finite (each with a
+// valid checksum where the damage is not the checksum's to find) is one clear
+// error, never a wrong image.
+TEST(Progressive, ADamagedCheckpointIsOneClearError) {
+    const CoinModel model(true);
+    const std::filesystem::path dir = TestDir("progressive_damaged");
+    RenderRequest request = CoinRequest(6, 3);
+    request.checkpoint = (dir / "coin").string();
+    Image image;
+    model.Render(request, &image);
+    const std::string path = request.checkpoint + ".bin";
+    std::string good;
+    {
+        std::ifstream f(path, std::ios::binary);
+        good.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+    }
+    ASSERT_GT(good.size(), 16u + 2 * 5 * 3 * 3 * sizeof(float));
+    auto write = [&](const std::string& bytes) {
+        std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+    };
+    // Recomputes the trailing FNV-1a checksum after an edit.
+    auto resum = [](std::string bytes) {
+        uint64_t h = 14695981039346656037ull;
+        for (size_t i = 0; i + 8 < bytes.size(); ++i) {
+            h ^= static_cast<unsigned char>(bytes[i]);
+            h *= 1099511628211ull;
+        }
+        std::memcpy(&bytes[bytes.size() - 8], &h, 8);
+        return bytes;
+    };
+    request.monte_carlo.spp = 12;
+    request.resume = true;
+    auto expect_damaged = [&](const std::string& bytes, const char* why) {
+        write(bytes);
+        try {
+            model.Render(request, &image);
+            ADD_FAILURE() << "resumed from a checkpoint with " << why;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("is damaged"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+        }
+    };
+    expect_damaged(good.substr(0, good.size() - 100), "checksum");
+    expect_damaged(good.substr(0, 12), "truncated");
+    std::string flipped = good;
+    flipped[good.size() - 20] ^= 0x10;
+    expect_damaged(flipped, "checksum");
+    const size_t at = good.find("\"samples_done\":6");
+    ASSERT_NE(at, std::string::npos);
+    std::string counts = good;
+    counts[at + 15] = '2';  // 2 samples in 2 passes of 3
+    expect_damaged(resum(counts), "counts disagree");
+    std::string nan = good;
+    const float q = std::numeric_limits<float>::quiet_NaN();
+    std::memcpy(&nan[good.size() - 8 - 4], &q, 4);
+    expect_damaged(resum(nan), "not finite");
+    std::string longer = good;
+    longer.insert(good.size() - 8, 4, '\0');
+    expect_damaged(resum(longer), "wrong size");
+    // The intact checkpoint resumes to the uninterrupted image.
+    write(good);
+    Image resumed, full;
+    model.Render(request, &resumed);
+    model.Render(CoinRequest(12, 3), &full);
+    EXPECT_EQ(std::memcmp(resumed.data(), full.data(), full.size() * sizeof(float)), 0);
+    // The temporary file is gone once committed.
+    EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+}
+
+}  // namespace
+}  // namespace atmos
