@@ -29,11 +29,11 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
+#include "models/evaluator_model.h"
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
 #include "physics/single_scattering.h"
-#include "render/render.h"
 
 namespace atmos {
 
@@ -78,10 +78,7 @@ class NaiveModel : public SimpleEvaluatorModel<NaiveModel, NaiveEvaluator> {
   public:
     explicit NaiveModel(const ModelOptions& options);
     static ModelInfo StaticInfo();
-    void Prepare(const AtmosphereParameters& atmosphere) override {
-        atm_ = atmosphere;
-        evaluator_.atm = atmosphere;
-    }
+    void Prepare(const AtmosphereParameters& atmosphere) override { SetAtmosphere(atmosphere); }
 };
 
 }  // namespace atmos

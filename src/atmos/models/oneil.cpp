@@ -59,7 +59,7 @@ OneilModel::OneilModel(const ModelOptions& options) {
 }
 
 void OneilModel::Prepare(const AtmosphereParameters& atmosphere) {
-    atm_ = atmosphere;
+    SetAtmosphere(atmosphere);
     evaluator_.optics = MakeOneilOptics(atmosphere, refit_);
 }
 

@@ -54,7 +54,7 @@ PreethamModel::PreethamModel(const ModelOptions& options) {
 }
 
 void PreethamModel::Prepare(const AtmosphereParameters& atmosphere) {
-    atm_ = atmosphere;
+    SetAtmosphere(atmosphere);
     evaluator_.bottom = atmosphere.bottom_radius;
     evaluator_.top = atmosphere.top_radius;
 }

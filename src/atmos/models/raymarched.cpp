@@ -22,7 +22,7 @@ RaymarchedModel::RaymarchedModel(const ModelOptions& options) {
 }
 
 void RaymarchedModel::Prepare(const AtmosphereParameters& atmosphere) {
-    atm_ = atmosphere;
+    SetAtmosphere(atmosphere);
     evaluator_.optics.m = MakeAnalyticMedia(atmosphere);
 }
 
