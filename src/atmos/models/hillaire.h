@@ -87,8 +87,11 @@
 // (default) the queries are grouped by (altitude, mu_s) and one sky-view table
 // is built per group inside the atmosphere (what a renderer would do per frame;
 // the table is relative to the sun's azimuth); no aerial-perspective volume, so
-// ground-hitting rays use the sky-view table's lower half. `--sample-path march`
-// ray marches every query (no per-frame tables).
+// ground-hitting rays use the sky-view table's lower half; each group's
+// queries go through the one launch (SampleAll, render/render.h) with that
+// table. `--sample-path march` ray marches every query (no per-frame tables).
+// On a device backend the model's two tables stay on the device from
+// Prepare() to its renders and samples (ResidentTables, render/stages.h).
 //
 // Precomputation: the four tables (transmittance, multiple scattering, and per
 // frame sky-view and aerial perspective) are built by the stage structs of
