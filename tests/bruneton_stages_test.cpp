@@ -131,7 +131,7 @@ struct Snapshot {
 Snapshot Run(const AtmosphereParameters& atm, const BrunetonConfig& c, bool texel_stages,
              BrunetonTables* tables) {
     Snapshot s;
-    PrecomputeBrunetonWith(atm, c, texel_stages, tables, nullptr,
+    PrecomputeBrunetonWith(atm, c, texel_stages, tables,
                            [&](int, const BrunetonTables& t, const Table* density) {
                                s.scattering.push_back(t.scattering);
                                s.irradiance.push_back(t.irradiance);

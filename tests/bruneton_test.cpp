@@ -263,14 +263,13 @@ TEST(Bruneton, OrdersDecreaseAndMultipleScatteringFraction) {
     const AtmosphereParameters atm = EarthAtmosphere();
     const BrunetonConfig cfg = Small(4);
     BrunetonTables tables;
-    PrecomputeBruneton(atm, cfg, &tables, nullptr,
-                       [&](int n, const BrunetonTables& t, const Table*) {
-                           BrunetonEvaluator e;
-                           e.lut = MakeBrunetonLut(atm, cfg, t);
-                           zenith[n] = Sky(e, 0.0, 1.0, 1.0);
-                           noon[n] = Sky(e, 0.0, std::sqrt(0.5), std::sin(Radians(60.0)), kPi / 2);
-                           twilight[n] = Sky(e, 0.0, 1.0, std::sin(Radians(-6.0)));
-                       });
+    PrecomputeBruneton(atm, cfg, &tables, [&](int n, const BrunetonTables& t, const Table*) {
+        BrunetonEvaluator e;
+        e.lut = MakeBrunetonLut(atm, cfg, t);
+        zenith[n] = Sky(e, 0.0, 1.0, 1.0);
+        noon[n] = Sky(e, 0.0, std::sqrt(0.5), std::sin(Radians(60.0)), kPi / 2);
+        twilight[n] = Sky(e, 0.0, 1.0, std::sin(Radians(-6.0)));
+    });
     Rgb prev_order;
     for (int n = 1; n <= 4; ++n) {
         const Rgb order = n == 1 ? zenith[1] : zenith[n] - zenith[n - 1];
@@ -479,7 +478,7 @@ TEST(Bruneton, ScatteringDensityMatchesTheSeedsFormulation) {
     double sum_rel = 0.0, max_rel = 0.0;
     int count = 0;
     PrecomputeBruneton(
-        atm, cfg, &tables, nullptr, [&](int order, const BrunetonTables& t, const Table* density) {
+        atm, cfg, &tables, [&](int order, const BrunetonTables& t, const Table* density) {
             static BrunetonTables single;
             if (order == 1) {
                 single = t;  // scattering = single Rayleigh, single_mie = single Mie

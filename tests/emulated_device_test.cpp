@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,6 +23,7 @@
 #include "models/bruneton.h"
 #include "models/bruneton_stages.h"
 #include "models/hillaire.h"
+#include "render/render.h"
 #include "render/stages.h"
 
 namespace atmos {
@@ -234,16 +237,15 @@ TEST(EmulatedDevice, BrunetonTablesMatchTheCpuTexelPath) {
         c.combined_mie = combined;
         BrunetonTables cpu, dev;
         std::vector<Table> cpu_density, dev_density;
-        PrecomputeBrunetonWith(atm, c, true, &cpu, nullptr,
+        PrecomputeBrunetonWith(atm, c, true, &cpu,
                                [&](int, const BrunetonTables&, const Table* density) {
                                    if (density) cpu_density.push_back(*density);
                                });
         {
             const BackendScope scope(Backend::kEmulatedDevice);
-            PrecomputeBruneton(atm, c, &dev, nullptr,
-                               [&](int, const BrunetonTables&, const Table* density) {
-                                   if (density) dev_density.push_back(*density);
-                               });
+            PrecomputeBruneton(atm, c, &dev, [&](int, const BrunetonTables&, const Table* density) {
+                if (density) dev_density.push_back(*density);
+            });
         }
         EXPECT_TRUE(SameBits(cpu.transmittance, dev.transmittance));
         EXPECT_TRUE(SameBits(cpu.irradiance, dev.irradiance));
@@ -257,6 +259,136 @@ TEST(EmulatedDevice, BrunetonTablesMatchTheCpuTexelPath) {
             ASSERT_TRUE(std::isfinite(dev.scattering.data()[i])) << i;
         }
     }
+}
+
+// The one launch (render/render.h): renders and samples of every registered
+// model on the emulated device equal the CPU's bit for bit (same model, same
+// tables); a model whose evaluator has no device kernels (not in
+// models/model_list.h), or whose evaluator holds a table its VisitTables does
+// not name, throws here. A second render uploads nothing: the model's tables
+// stay on the device.
+
+std::vector<SampleQuery> SomeQueries() {
+    std::vector<SampleQuery> queries;
+    for (double alt : {0.0, 3e3, 30e3, 200e3}) {
+        for (double mu : {-0.3, 0.02, 0.7}) {
+            for (double mu_s : {-0.05, 0.3}) queries.push_back({alt, mu, mu_s, 40.0});
+        }
+    }
+    return queries;
+}
+
+int64_t BytesUp(const std::vector<StageTime>& log) {
+    int64_t bytes = 0;
+    for (const StageTime& t : log) bytes += t.bytes_up;
+    return bytes;
+}
+
+void ExpectSameImages(const Image& a, const Image& b) {
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
+}
+
+TEST(EmulatedDevice, EveryModelRendersAndSamplesAsTheCpu) {
+    const AtmosphereParameters atm = EarthAtmosphere();
+    const std::vector<SampleQuery> queries = SomeQueries();
+    for (const ModelInfo& info : ListModels()) {
+        SCOPED_TRACE(info.name);
+        std::unique_ptr<Model> model = CreateModel(info.name);
+        model->Prepare(atm);
+        for (const char* view : {"ground-noon", "ground-sunrise", "orbit-sunrise", "space"}) {
+            SCOPED_TRACE(view);
+            RenderRequest request;
+            request.view = GetView(view, atm);
+            request.width = 12;
+            request.height = 7;  // (the reference: several passes, one launch each)
+            request.quantity =
+                info.capabilities.radiance ? Quantity::kRadiance : Quantity::kTransmittance;
+            request.show_progress = false;
+            Image cpu, dev, again;
+            model->Render(request, &cpu);
+            std::vector<StageTime> first, second;
+            {
+                const BackendScope scope(Backend::kEmulatedDevice);
+                {
+                    const StageLogScope log(&first);
+                    model->Render(request, &dev);
+                }
+                const StageLogScope log(&second);
+                model->Render(request, &again);
+            }
+            ExpectSameImages(cpu, dev);
+            ExpectSameImages(cpu, again);
+            int renders = 0;
+            for (const StageTime& t : second) {
+                if (t.name != "render") continue;
+                ++renders;
+                EXPECT_EQ(t.backend, "emulated-device");
+                EXPECT_EQ(t.items, int64_t{12} * 7);
+            }
+            EXPECT_GE(renders, 1);
+            EXPECT_EQ(BytesUp(second), 0) << "a second render uploaded tables again";
+        }
+        const std::vector<SampleAnswer> a = model->Sample(queries);
+        std::vector<SampleAnswer> b;
+        std::vector<StageTime> log;
+        {
+            const BackendScope scope(Backend::kEmulatedDevice);
+            const StageLogScope logging(&log);
+            b = model->Sample(queries);
+        }
+        ASSERT_EQ(a.size(), b.size());
+        EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(SampleAnswer)), 0);
+        bool launched = false;
+        for (const StageTime& t : log) launched = launched || t.name == "sample";
+        EXPECT_TRUE(launched) << "Sample did not go through the launch";
+    }
+}
+
+// Tables built on the device stay there for the renders: the first render
+// after an emulated Prepare uploads nothing either.
+TEST(EmulatedDevice, TablesStayOnTheDeviceFromPrepareToRender) {
+    const AtmosphereParameters atm = EarthAtmosphere();
+    for (const char* name : {"hillaire", "atmosphere-plus"}) {
+        SCOPED_TRACE(name);
+        std::unique_ptr<Model> model = CreateModel(name);
+        const BackendScope scope(Backend::kEmulatedDevice);
+        model->Prepare(atm);
+        RenderRequest request;
+        request.view = GetView("ground-sunrise", atm);
+        request.width = 8;
+        request.height = 4;
+        request.show_progress = false;
+        std::vector<StageTime> log;
+        const StageLogScope logging(&log);
+        Image image;
+        model->Render(request, &image);
+        EXPECT_EQ(BytesUp(log), 0);
+    }
+}
+
+// A stage (or evaluator) holding a TableView its VisitTables does not name is
+// one clear error on the emulated device (the device would read host memory).
+struct HidesATableStage {
+    TableView named;
+    TableView hidden;
+    TableOut out;
+    template <typename V>
+    void VisitTables(V& v) {
+        v(named);
+        v(out);
+    }
+    ATMOS_HD void operator()(int64_t i) const { out.data[i] = named.data[i] + hidden.data[i]; }
+};
+
+TEST(EmulatedDevice, ATableThatVisitTablesDoesNotNameIsAnError) {
+    const Table a = Filled(8, 1.0f), b = Filled(8, 2.0f);
+    Table out(8, 1, 1, 1);
+    HidesATableStage stage{a.view(), b.view(), out.out()};
+    RunStage("hides", 8, 1, stage);  // the CPU reads host memory: fine
+    EXPECT_EQ(out.data()[0], 3.0f);
+    const BackendScope scope(Backend::kEmulatedDevice);
+    EXPECT_THROW(RunStage("hides", 8, 1, stage), Error);
 }
 
 }  // namespace

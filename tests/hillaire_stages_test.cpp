@@ -48,8 +48,6 @@ TEST(HillaireStages, PrepareRenderAndSampleRunTheirTablesAsStages) {
         EXPECT_EQ(t.backend, "cpu");
         EXPECT_GE(t.kernel_ms, 0.0);
     }
-    EXPECT_GT(model.prepare_timings().transmittance_s, 0.0);
-    EXPECT_GT(model.prepare_timings().multiple_scattering_s, 0.0);
 
     // A render inside the atmosphere builds its frame tables as stages...
     log.clear();
@@ -60,26 +58,27 @@ TEST(HillaireStages, PrepareRenderAndSampleRunTheirTablesAsStages) {
     request.show_progress = false;
     Image image;
     model.Render(request, &image);
-    ASSERT_EQ(Names(log),
-              (std::vector<std::string>{"hillaire/sky-view", "hillaire/aerial-perspective"}));
+    // (the one launch log: the render's own launch follows its tables)
+    ASSERT_EQ(Names(log), (std::vector<std::string>{"hillaire/sky-view",
+                                                    "hillaire/aerial-perspective", "render"}));
     EXPECT_EQ(log[0].items, kHillaireSkyViewWidth * kHillaireSkyViewHeight);
     EXPECT_EQ(log[1].items, kHillaireApSize * kHillaireApSize);
-    EXPECT_GT(model.last_frame_timings().sky_view_s, 0.0);
-    EXPECT_GT(model.last_frame_timings().aerial_perspective_s, 0.0);
 
     // ... one outside it none (ray march), and Sample one sky-view table per
-    // (altitude, sun) group inside the atmosphere.
+    // (altitude, sun) group inside the atmosphere, each group's queries
+    // through the one launch.
     log.clear();
     request.view = GetView("space", atm);
     model.Render(request, &image);
-    EXPECT_TRUE(log.empty());
+    EXPECT_EQ(Names(log), (std::vector<std::string>{"render"}));
     log.clear();
     const std::vector<SampleQuery> queries = {{0.0, 0.5, 0.2, 60.0},
                                               {0.0, -0.1, 0.2, 60.0},
                                               {1e3, 0.5, 0.2, 60.0},
                                               {200e3, 0.5, 0.2, 60.0}};
     (void)model.Sample(queries);
-    EXPECT_EQ(Names(log), (std::vector<std::string>{"hillaire/sky-view", "hillaire/sky-view"}));
+    EXPECT_EQ(Names(log), (std::vector<std::string>{"hillaire/sky-view", "sample",
+                                                    "hillaire/sky-view", "sample", "sample"}));
 }
 
 // The stages write only their own texels, so the tables do not depend on the

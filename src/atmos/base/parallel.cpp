@@ -53,7 +53,6 @@ void ParallelForTiles(int width, int height, int tile,
 
 namespace {
 std::atomic<Backend> g_backend{Backend::kCpu};
-std::atomic<DeviceTimingRequest*> g_device_timing{nullptr};
 }  // namespace
 
 Backend ParseBackend(const std::string& text) {
@@ -96,10 +95,5 @@ BackendScope::BackendScope(Backend backend) : previous_(g_backend.load()) {
 }
 BackendScope::~BackendScope() { g_backend.store(previous_); }
 Backend CurrentBackend() { return g_backend.load(); }
-
-DeviceTimingScope::DeviceTimingScope(DeviceTimingRequest* request)
-    : previous_(g_device_timing.exchange(request)) {}
-DeviceTimingScope::~DeviceTimingScope() { g_device_timing.store(previous_); }
-DeviceTimingRequest* CurrentDeviceTiming() { return g_device_timing.load(); }
 
 }  // namespace atmos

@@ -4,11 +4,11 @@
 // Work is split into independent items; results must not depend on the
 // schedule, so a render is bit-identical for any thread count.
 //
-// Backend: the per-pixel loops (RenderImage and SampleAll in render/render.h)
-// run on the CPU (ParallelFor, the default) or, in a build with CUDA
-// (ATMOS_CUDA, which defines ATMOS_HAS_CUDA), as CUDA kernels over the same
-// ShadePixel(). The choice is made here, once per process (BackendScope), and
-// read only by those two loops; precomputation always runs on the CPU.
+// Backend: the one loop of the project (RunStage, render/stages.h: renders,
+// samples and precomputation stages) runs on the CPU (ParallelFor, the
+// default) or, in a build with CUDA (ATMOS_CUDA, which defines
+// ATMOS_HAS_CUDA), as CUDA kernels over the same per-item code. The choice is
+// made here, once per process (BackendScope), and read by that loop.
 #pragma once
 
 #include <cstdint>
@@ -42,9 +42,9 @@ void ParallelFor(int64_t count, int64_t grain, const std::function<void(int64_t)
 void ParallelForTiles(int width, int height, int tile,
                       const std::function<void(int, int, int, int)>& body);
 
-// kEmulatedDevice: tests only (not a command-line choice): renders run on the
-// CPU, precomputation stages run the CUDA backend's bookkeeping with host memory
-// standing in for the device (render/stages.h).
+// kEmulatedDevice: tests only (not a command-line choice): every launch
+// (renders, samples, precomputation stages) runs the CUDA backend's
+// bookkeeping with host memory standing in for the device (render/stages.h).
 enum class Backend { kCpu, kCuda, kEmulatedDevice };
 // True for the backends whose precomputations keep tables in device copies.
 inline bool IsDeviceBackend(Backend backend) { return backend != Backend::kCpu; }
@@ -73,27 +73,5 @@ class BackendScope {
     Backend previous_;
 };
 Backend CurrentBackend();
-
-// Kernel timing on the CUDA backend (`atmos bench --backend cuda`): while a
-// request is installed, every device render launches its kernel `warmup`
-// times untimed, then `repeats` times, each between two CUDA events, and
-// stores the per-launch milliseconds in `milliseconds` (uploads and copies
-// excluded). Ignored by the CPU backend.
-struct DeviceTimingRequest {
-    int warmup = 16;
-    int repeats = 256;
-    std::vector<float> milliseconds;
-};
-class DeviceTimingScope {
-  public:
-    explicit DeviceTimingScope(DeviceTimingRequest* request);
-    ~DeviceTimingScope();
-    DeviceTimingScope(const DeviceTimingScope&) = delete;
-    DeviceTimingScope& operator=(const DeviceTimingScope&) = delete;
-
-  private:
-    DeviceTimingRequest* previous_;
-};
-DeviceTimingRequest* CurrentDeviceTiming();
 
 }  // namespace atmos

@@ -180,6 +180,8 @@ class Table {
         return o;
     }
     uint64_t id() const { return view_.id; }
+    // The largest id() handed out so far (0 before the first table).
+    static uint64_t LastId() { return NextId().load() - 1; }
     int width() const { return view_.width; }
     int height() const { return view_.height; }
     int depth() const { return view_.depth; }
@@ -198,10 +200,11 @@ class Table {
     }
 
   private:
-    static uint64_t NewId() {
+    static std::atomic<uint64_t>& NextId() {
         static std::atomic<uint64_t> next{1};
-        return next.fetch_add(1);
+        return next;
     }
+    static uint64_t NewId() { return NextId().fetch_add(1); }
     std::vector<float> data_;
     TableView view_;
 };

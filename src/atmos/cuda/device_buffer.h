@@ -1,9 +1,8 @@
 // atmos: device memory for the CUDA backend (nvcc / CUDA runtime only).
 //
 // DeviceBuffer: one cudaMalloc'd allocation, freed by its destructor (RAII,
-// move-only). DeviceTables: the buffers of one device render (the LUTs of an
-// evaluator); UploadTable() copies a host TableView into it and returns a
-// TableView of the same shape pointing to device memory.
+// move-only). Tables reach the device through StageSession (render/stages.h,
+// cuda/stage_memory.cu), renders included.
 #pragma once
 
 #include <cuda_runtime.h>
@@ -59,25 +58,6 @@ class DeviceBuffer {
   private:
     void* data_ = nullptr;
     size_t bytes_ = 0;
-};
-
-// The device buffers one evaluator's tables live in (kept alive for a render).
-class DeviceTables {
-  public:
-    TableView Upload(const TableView& host) {
-        TableView device = host;
-        if (!host.data) return device;
-        const size_t bytes = static_cast<size_t>(host.width) * host.height * host.depth *
-                             host.channels * sizeof(float);
-        buffers_.emplace_back(bytes);
-        buffers_.back().CopyFromHost(host.data, bytes);
-        device.data = static_cast<const float*>(buffers_.back().data());
-        return device;
-    }
-    size_t count() const { return buffers_.size(); }
-
-  private:
-    std::vector<DeviceBuffer> buffers_;
 };
 
 }  // namespace atmos::cuda

@@ -2,7 +2,9 @@
 //
 // A .cu file includes this header and the stage's header, then writes
 // ATMOS_INSTANTIATE_DEVICE_STAGE(TheStage) for each stage it declared with
-// ATMOS_DEVICE_STAGE.
+// ATMOS_DEVICE_STAGE; render_kernels.cu instantiates the render and sample
+// launches (RenderStage, SampleStage of render/render.h) for every model of
+// models/model_list.h.
 //
 // RunStageDevice binds the stage's tables to device copies (StageBinding: in
 // the current StageSession, or copied in and out around this one run),

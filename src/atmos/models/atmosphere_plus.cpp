@@ -192,7 +192,10 @@ void AtmospherePlusModel::Prepare(const AtmosphereParameters& atmosphere) {
     atm_ = atmosphere;
     settings_.mapping.bottom_radius = atm_.bottom_radius;
     settings_.mapping.height = atm_.top_radius - atm_.bottom_radius;
+    // On a device backend the final tables stay on the device for the renders.
+    ResidentScope scope(&resident_);
     tables_ = AplusPrecompute(atm_, settings_);
+    scope.Keep(MakeEvaluator());
 }
 
 namespace {

@@ -60,11 +60,11 @@
 #include "atmos/model.h"
 #include "base/texture.h"
 #include "models/atmosphere_plus_mapping.h"
+#include "models/evaluator_model.h"
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
 #include "physics/transmittance.h"
-#include "render/render.h"
 
 namespace atmos {
 
@@ -249,6 +249,13 @@ struct AtmospherePlusEvaluator {
     TableView transmittance;
     bool modified_rayleigh = false;
 
+    // Names every table (physics/ray.h: the device launch re-points these).
+    template <typename V>
+    void VisitTables(V& v) {
+        v(scattering);
+        v(transmittance);
+    }
+
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                 bool want_ground) const {
         RayResult out;
@@ -287,6 +294,7 @@ struct AtmospherePlusEvaluator {
 // the table). The stand-in reference for the table error of order-1 tables
 // (tests, docs/models/atmosphere-plus.md); host use only (slow).
 struct AtmospherePlusDirectEvaluator {
+    static constexpr bool kHostOnly = true;  // no device kernels (physics/ray.h)
     AtmosphereParameters atm;
     int steps = 30, sun_steps = 30;
     bool modified_rayleigh = false;

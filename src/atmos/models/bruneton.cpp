@@ -85,9 +85,12 @@ BrunetonModel::BrunetonModel(const BrunetonConfig& options)
     : info_(StaticInfo()), config_(options), atm_(EarthAtmosphere()) {}
 
 void BrunetonModel::Prepare(const AtmosphereParameters& atmosphere) {
+    // On a device backend the final tables stay on the device for the renders.
+    ResidentScope scope(&resident_);
     atm_ = atmosphere;
-    PrecomputeBruneton(atm_, config_, &tables_, &timings_);
+    PrecomputeBruneton(atm_, config_, &tables_);
     prepared_ = true;
+    scope.Keep(MakeEvaluator());
 }
 
 BrunetonEvaluator BrunetonModel::MakeEvaluator() const {
@@ -232,7 +235,6 @@ void BrunetonModel::LoadBaked(const std::string& directory,
     }
     tables_ = std::move(t);
     atm_ = atmosphere;
-    timings_ = BrunetonTimings();
     prepared_ = true;
 }
 

@@ -47,10 +47,10 @@
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "base/texture.h"
+#include "models/evaluator_model.h"
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
-#include "render/render.h"
 
 namespace atmos {
 
@@ -451,6 +451,12 @@ struct BrunetonLut {
 struct BrunetonEvaluator {
     BrunetonLut lut;
 
+    // Names every table (physics/ray.h: the device launch re-points these).
+    template <typename V>
+    void VisitTables(V& v) {
+        lut.VisitTables(v);
+    }
+
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                 bool want_ground) const {
         RayResult out;
@@ -490,22 +496,6 @@ struct BrunetonTables {
     Table single_mie;     // same size, 3 channels (separate storage), else empty
 };
 
-// Seconds per precomputation stage (wall: on the CUDA backend with the copies
-// to and from the device; the kernels alone are in the stage log, StageLogScope).
-struct BrunetonStageTimes {
-    double transmittance = 0.0;
-    double direct_irradiance = 0.0;
-    double single_scattering = 0.0;
-    double scattering_density = 0.0;  // all orders together
-    double indirect_irradiance = 0.0;
-    double multiple_scattering = 0.0;
-    double total = 0.0;
-};
-struct BrunetonTimings {
-    BrunetonStageTimes wall;  // wall clock
-    BrunetonStageTimes cpu;   // process CPU time (all threads: std::clock)
-};
-
 // Called with the tables as they stand after each scattering order (1..N), and
 // that order's scattering density J_n (nullptr for order 1): for tests.
 using BrunetonOrderCallback =
@@ -514,10 +504,10 @@ using BrunetonOrderCallback =
 // The whole precomputation of seed 004, stage by stage through RunStage
 // (models/bruneton_stages.h): on the CPU (ParallelFor) or, on the CUDA backend,
 // on the device. Tables are per unit solar irradiance. Throws atmos::Error for
-// an invalid configuration.
+// an invalid configuration. Each stage's time is in the stage log
+// (StageLogScope, render/stages.h).
 void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
-                        BrunetonTables* tables, BrunetonTimings* timings = nullptr,
-                        const BrunetonOrderCallback& on_order = nullptr);
+                        BrunetonTables* tables, const BrunetonOrderCallback& on_order = nullptr);
 
 // Checks sizes and orders; throws atmos::Error naming the bad option.
 void ValidateBrunetonConfig(const BrunetonConfig& config);
@@ -543,14 +533,12 @@ class BrunetonModel : public EvaluatorModel<BrunetonModel> {
 
     const BrunetonConfig& config() const { return config_; }
     const BrunetonTables& tables() const { return tables_; }
-    const BrunetonTimings& timings() const { return timings_; }
 
   private:
     ModelInfo info_;
     BrunetonConfig config_;
     AtmosphereParameters atm_;
     BrunetonTables tables_;
-    BrunetonTimings timings_;
     bool prepared_ = false;
 };
 

@@ -7,7 +7,6 @@
 // backend single and multiple scattering use their row forms (faster on the CPU).
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <vector>
 
 #include "atmos/error.h"
@@ -22,15 +21,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Wall and CPU time of one stage, added to a field of both.
-struct Stopwatch {
-    Clock::time_point wall = Clock::now();
-    std::clock_t cpu = std::clock();
-    void AddTo(BrunetonTimings* t, double BrunetonStageTimes::*field) const {
-        t->wall.*field += std::chrono::duration<double>(Clock::now() - wall).count();
-        t->cpu.*field += static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
-    }
-};
 
 // Rows of the 3D scattering table: one (mu, r) pair = (y, z), NU * MU_S texels.
 int RowCount(const BrunetonConfig& c) { return c.scattering_mu * c.scattering_r; }
@@ -177,18 +167,14 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
 }
 
 void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
-                        BrunetonTables* tables, BrunetonTimings* timings,
-                        const BrunetonOrderCallback& on_order) {
-    PrecomputeBrunetonWith(atmosphere, config, IsDeviceBackend(CurrentBackend()), tables, timings,
-                           on_order);
+                        BrunetonTables* tables, const BrunetonOrderCallback& on_order) {
+    PrecomputeBrunetonWith(atmosphere, config, IsDeviceBackend(CurrentBackend()), tables, on_order);
 }
 
 void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
-                            bool texel_stages, BrunetonTables* tables, BrunetonTimings* timings,
+                            bool texel_stages, BrunetonTables* tables,
                             const BrunetonOrderCallback& on_order) {
     ValidateBrunetonConfig(config);
-    BrunetonTimings t;
-    const Stopwatch start;
     BrunetonLut lut;
     lut.atm = atmosphere;
     lut.cfg = config;
@@ -205,24 +191,19 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
         if (delta_density) session.Download(delta_density);
     };
 
-    Stopwatch stage;
     tables->transmittance.Resize(config.transmittance_width, config.transmittance_height, 1, 3);
     RunStage("bruneton transmittance", TexelCount(tables->transmittance),
              config.transmittance_width,
              BrunetonTransmittanceStage{mappings, tables->transmittance.out()});
     lut.transmittance_table = tables->transmittance.view();
-    stage.AddTo(&t, &BrunetonStageTimes::transmittance);
 
-    stage = Stopwatch();
     Table delta_irradiance(config.irradiance_width, config.irradiance_height, 1, 3);
     RunStage("bruneton direct irradiance", TexelCount(delta_irradiance), config.irradiance_width,
              BrunetonDirectIrradianceStage{lut, delta_irradiance.out()});
     // The irradiance table holds the indirect irradiance only (the direct one is
     // computed at render time from the transmittance, seed 004).
     tables->irradiance.Resize(config.irradiance_width, config.irradiance_height, 1, 3);
-    stage.AddTo(&t, &BrunetonStageTimes::direct_irradiance);
 
-    stage = Stopwatch();
     Table delta_rayleigh, delta_mie;
     if (texel_stages) {
         delta_rayleigh.Resize(width, config.scattering_mu, config.scattering_r, 3);
@@ -242,7 +223,6 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
     RunStage("bruneton combine", TexelCount(delta_rayleigh), width,
              BrunetonCombineStage{delta_rayleigh.view(), delta_mie.view(), tables->scattering.out(),
                                   config.combined_mie ? TableOut() : tables->single_mie.out()});
-    stage.AddTo(&t, &BrunetonStageTimes::single_scattering);
     if (on_order) {
         download(nullptr);
         on_order(1, *tables, nullptr);
@@ -251,7 +231,6 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
     const Table directions = MakeBrunetonDirectionTable();
     Table incident, delta_multiple, delta_density;
     for (int order = 2; order <= config.orders; ++order) {
-        stage = Stopwatch();
         // 1. Incident radiance per (r, mu_s, direction); 2. per texel, its
         // phase-weighted sums in the sun's frame.
         incident.Resize(3 * kBrunetonDirections, config.scattering_mu_s, config.scattering_r, 1);
@@ -279,9 +258,7 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
         RunStage("bruneton scattering density", TexelCount(delta_density), width,
                  BrunetonDensityStage{mappings, incident.view(), directions.view(),
                                       delta_density.out()});
-        stage.AddTo(&t, &BrunetonStageTimes::scattering_density);
 
-        stage = Stopwatch();
         BrunetonIndirectIrradianceStage irr;
         irr.lut = mappings;
         irr.order = order - 1;
@@ -295,9 +272,7 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
         RunStage("bruneton indirect irradiance", TexelCount(delta_irradiance), 4, irr);
         RunStage("bruneton add irradiance", TexelCount(delta_irradiance), config.irradiance_width,
                  BrunetonAddStage{delta_irradiance.view(), tables->irradiance.out(true)});
-        stage.AddTo(&t, &BrunetonStageTimes::indirect_irradiance);
 
-        stage = Stopwatch();
         if (texel_stages) {
             delta_multiple.Resize(width, config.scattering_mu, config.scattering_r, 3);
             RunStage(
@@ -311,15 +286,12 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
         RunStage(
             "bruneton accumulate", TexelCount(delta_multiple), width,
             BrunetonAccumulateStage{mappings, delta_multiple.view(), tables->scattering.out(true)});
-        stage.AddTo(&t, &BrunetonStageTimes::multiple_scattering);
         if (on_order) {
             download(&delta_density);
             on_order(order, *tables, &delta_density);
         }
     }
     download(nullptr);
-    start.AddTo(&t, &BrunetonStageTimes::total);
-    if (timings) *timings = t;
 }
 
 }  // namespace atmos

@@ -662,7 +662,6 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
 // texel_stages = (CurrentBackend() == Backend::kCuda).
 void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
                             bool texel_stages, BrunetonTables* tables,
-                            BrunetonTimings* timings = nullptr,
                             const BrunetonOrderCallback& on_order = nullptr);
 
 }  // namespace atmos

@@ -7,7 +7,7 @@
 #pragma once
 
 #include "atmos/model.h"
-#include "render/render.h"
+#include "models/evaluator_model.h"
 
 namespace atmos {
 
@@ -26,7 +26,7 @@ class EmptyModel : public SimpleEvaluatorModel<EmptyModel, EmptyEvaluator> {
     static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit EmptyModel(const NoOptions&) {}
     static ModelInfo StaticInfo();
-    void Prepare(const AtmosphereParameters& atmosphere) override { atm_ = atmosphere; }
+    void Prepare(const AtmosphereParameters& atmosphere) override { SetAtmosphere(atmosphere); }
 };
 
 }  // namespace atmos

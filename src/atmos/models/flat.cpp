@@ -18,7 +18,7 @@ ModelInfo FlatModel::StaticInfo() {
 FlatModel::FlatModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
 
 void FlatModel::Prepare(const AtmosphereParameters& atmosphere) {
-    atm_ = atmosphere;
+    SetAtmosphere(atmosphere);
     evaluator_.optics.m = MakeAnalyticMedia(atmosphere);
 }
 

@@ -2,7 +2,6 @@
 // See hillaire.h for the source, equations and deviations.
 #include "models/hillaire.h"
 
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -20,14 +19,6 @@
 #include "render/stages.h"
 
 namespace atmos {
-
-namespace {
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
 
 HillaireEvaluator HillaireFrame::Evaluator() const {
     HillaireEvaluator e = base;
@@ -102,16 +93,15 @@ void HillaireModel::Prepare(const AtmosphereParameters& atmosphere) {
     ValidateAtmosphere(atmosphere);
     evaluator_.atm = atmosphere;
     // On a device backend the transmittance table stays on the device for the
-    // multiple-scattering stage; both come back at the end.
+    // multiple-scattering stage; both come back at the end, and stay on the
+    // device for the renders (the model's resident session).
+    ResidentScope scope(&resident_);
     StageSession session;
-    auto start = std::chrono::steady_clock::now();
     BuildTransmittance();
-    prepare_timings_.transmittance_s = SecondsSince(start);
-    start = std::chrono::steady_clock::now();
     BuildMultipleScattering();
     session.Download(&transmittance_);
     session.Download(&multiple_scattering_);
-    prepare_timings_.multiple_scattering_s = SecondsSince(start);
+    scope.Keep(evaluator_);
 }
 
 // The evaluator the precomputation stages read: the model's tables, no frame
@@ -176,9 +166,7 @@ std::unique_ptr<HillaireFrame> HillaireModel::BuildFrame(const Camera& camera_fr
     if (!(r <= atm.top_radius) || !transmittance_.size()) return frame;  // ray march
     const double mu_s = ClampCosine(Dot(sun, camera) / r);
     StageSession session;  // the model's tables are uploaded once for both stages
-    auto start = std::chrono::steady_clock::now();
     BuildSkyView(r, mu_s, &frame->sky_view);
-    frame->timings.sky_view_s = SecondsSince(start);
     if (!with_aerial_perspective) {
         session.Download(&frame->sky_view);
         return frame;
@@ -186,7 +174,6 @@ std::unique_ptr<HillaireFrame> HillaireModel::BuildFrame(const Camera& camera_fr
 
     // Aerial-perspective volume: one cumulative march per screen texel column
     // (HillaireAerialPerspectiveStage).
-    start = std::chrono::steady_clock::now();
     frame->base.ap_camera = camera_frame;
     frame->base.ap_aspect = aspect;
     frame->ap_scatter.Resize(kHillaireApSize, kHillaireApSize, kHillaireApSize, 3);
@@ -204,17 +191,18 @@ std::unique_ptr<HillaireFrame> HillaireModel::BuildFrame(const Camera& camera_fr
     session.Download(&frame->sky_view);
     session.Download(&frame->ap_scatter);
     session.Download(&frame->ap_transmittance);
-    frame->timings.aerial_perspective_s = SecondsSince(start);
     return frame;
 }
 
 void HillaireModel::Render(const RenderRequest& request, Image* out) const {
     if (!transmittance_.size()) Fail("model hillaire: Prepare() was not called");
     const PixelSetup setup = MakePixelSetup(request, evaluator_.atm);
+    // The model's tables stay on the device; the frame's are dropped after.
+    ResidentScope scope(&resident_);
+    scope.Keep(evaluator_);
     const std::unique_ptr<HillaireFrame> frame =
         BuildFrame(request.view.camera, request.view.sun_direction,
                    static_cast<double>(request.width) / request.height, evaluator_.ground_from_ap);
-    last_frame_timings_ = frame->timings;
     out->Resize(request.width, request.height);
     RenderImage(frame->Evaluator(), setup, out->View(), request.show_progress);
 }
@@ -222,6 +210,8 @@ void HillaireModel::Render(const RenderRequest& request, Image* out) const {
 std::vector<SampleAnswer> HillaireModel::Sample(const std::vector<SampleQuery>& queries) const {
     if (!transmittance_.size()) Fail("model hillaire: Prepare() was not called");
     const AtmosphereParameters& atm = evaluator_.atm;
+    ResidentScope scope(&resident_);
+    scope.Keep(evaluator_);
     if (!sample_with_tables_) return SampleAll(evaluator_, atm.bottom_radius, queries);
     // Group the queries by (altitude, mu_s): one sky-view table per group.
     std::map<std::pair<double, double>, std::vector<size_t>> groups;
@@ -229,11 +219,13 @@ std::vector<SampleAnswer> HillaireModel::Sample(const std::vector<SampleQuery>& 
         groups[{queries[q].altitude_m, queries[q].mu_s}].push_back(q);
     }
     std::vector<SampleAnswer> answers(queries.size());
-    // On a device backend the model's tables are uploaded once for all groups;
-    // each group's sky-view table is resized in place (its old device copy is
-    // dropped) and downloaded for the host's queries.
+    // On a device backend the model's tables stay on the device for all
+    // groups; each group's sky-view table is resized in place (its old device
+    // copy is dropped) and its queries go through the one launch (SampleAll)
+    // with that table, which the device already holds.
     StageSession session;
     Table sky_view;
+    std::vector<SampleQuery> group_queries;
     for (const auto& group : groups) {
         const double r = atm.bottom_radius + group.first.first;
         HillaireEvaluator e = evaluator_;
@@ -243,10 +235,11 @@ std::vector<SampleAnswer> HillaireModel::Sample(const std::vector<SampleQuery>& 
             e.sky_view = sky_view.view();
         }
         const std::vector<size_t>& members = group.second;
-        ParallelFor(static_cast<int64_t>(members.size()), 64, [&](int64_t k) {
-            const size_t q = members[static_cast<size_t>(k)];
-            answers[q] = SampleOne(e, atm.bottom_radius, queries[q]);
-        });
+        group_queries.clear();
+        for (size_t q : members) group_queries.push_back(queries[q]);
+        const std::vector<SampleAnswer> group_answers =
+            SampleAll(e, atm.bottom_radius, group_queries);
+        for (size_t k = 0; k < members.size(); ++k) answers[members[k]] = group_answers[k];
     }
     return answers;
 }
@@ -336,7 +329,6 @@ void HillaireModel::LoadBaked(const std::string& directory,
     }
     transmittance_ = std::move(t);
     multiple_scattering_ = std::move(m);
-    prepare_timings_ = HillairePrepareTimings{};
     Attach();
 }
 

@@ -87,8 +87,11 @@
 // (default) the queries are grouped by (altitude, mu_s) and one sky-view table
 // is built per group inside the atmosphere (what a renderer would do per frame;
 // the table is relative to the sun's azimuth); no aerial-perspective volume, so
-// ground-hitting rays use the sky-view table's lower half. `--sample-path march`
-// ray marches every query (no per-frame tables).
+// ground-hitting rays use the sky-view table's lower half; each group's
+// queries go through the one launch (SampleAll, render/render.h) with that
+// table. `--sample-path march` ray marches every query (no per-frame tables).
+// On a device backend the model's two tables stay on the device from
+// Prepare() to its renders and samples (ResidentTables, render/stages.h).
 //
 // Precomputation: the four tables (transmittance, multiple scattering, and per
 // frame sky-view and aerial perspective) are built by the stage structs of
@@ -103,10 +106,10 @@
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "base/texture.h"
+#include "models/evaluator_model.h"
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
-#include "render/render.h"
 
 namespace atmos {
 
@@ -236,6 +239,16 @@ struct HillaireEvaluator {
     Camera ap_camera;            // the frustum the volume was built for
     double ap_aspect = 1.0;
     double ap_metres_per_slice = 4000.0;
+
+    // Names every table (physics/ray.h: the device launch re-points these).
+    template <typename V>
+    void VisitTables(V& v) {
+        v(transmittance);
+        v(multiple_scattering);
+        v(sky_view);
+        v(ap_scatter);
+        v(ap_transmittance);
+    }
 
     ATMOS_HD Vec3d Transmittance(double r, double mu) const {
         double u, v;
@@ -402,16 +415,6 @@ struct HillaireEvaluator {
     }
 };
 
-// Build times of the tables, seconds (wall clock, host).
-struct HillairePrepareTimings {
-    double transmittance_s = 0.0;
-    double multiple_scattering_s = 0.0;
-};
-struct HillaireFrameTimings {
-    double sky_view_s = 0.0;
-    double aerial_perspective_s = 0.0;  // 0 when not built (camera outside)
-};
-
 // The per-frame tables for one camera and sun. Not copyable: the evaluator
 // references the tables.
 class HillaireFrame {
@@ -421,7 +424,6 @@ class HillaireFrame {
     HillaireFrame& operator=(const HillaireFrame&) = delete;
     // The evaluator with this frame's tables attached.
     HillaireEvaluator Evaluator() const;
-    HillaireFrameTimings timings;
     HillaireEvaluator base;
     Table sky_view, ap_scatter, ap_transmittance;  // empty when not built
 };
@@ -447,8 +449,8 @@ class HillaireModel : public Model {
     // Builds the transmittance and multiple-scattering tables (timed).
     void Prepare(const AtmosphereParameters& atmosphere) override;
     // Builds the frame (sky-view and aerial perspective for the view's camera
-    // and sun), then renders through it. The frame's timings are kept in
-    // last_frame_timings() (not thread-safe: one Render at a time per model).
+    // and sun), then renders through it (not thread-safe: one Render at a time
+    // per model). Each table's build time is in the stage log (StageLogScope).
     void Render(const RenderRequest& request, Image* out) const override;
     std::vector<SampleAnswer> Sample(const std::vector<SampleQuery>& queries) const override;
     bool CanBake() const override { return true; }
@@ -469,8 +471,6 @@ class HillaireModel : public Model {
     // Evaluator without per-frame tables (ray march everywhere).
     HillaireEvaluator MakeEvaluator() const { return evaluator_; }
     const AtmosphereParameters& atmosphere() const { return evaluator_.atm; }
-    const HillairePrepareTimings& prepare_timings() const { return prepare_timings_; }
-    const HillaireFrameTimings& last_frame_timings() const { return last_frame_timings_; }
     const Table& transmittance_table() const { return transmittance_; }
     const Table& multiple_scattering_table() const { return multiple_scattering_; }
     // The two steps of Prepare(), public for benchmarks: the transmittance
@@ -492,8 +492,7 @@ class HillaireModel : public Model {
     int ap_steps_per_slice_ = 4;
     bool sample_with_tables_ = true;
     Table transmittance_, multiple_scattering_;
-    HillairePrepareTimings prepare_timings_;
-    mutable HillaireFrameTimings last_frame_timings_;
+    mutable ResidentTables resident_;  // the tables' device copies (render/stages.h)
 };
 
 }  // namespace atmos

@@ -27,17 +27,6 @@ ATMOS_HD inline Vec4f HillaireTexel(const Vec3d& v) {
     return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0.0f};
 }
 
-// Every table an evaluator references (absent ones, data == nullptr, are
-// skipped by RunStage).
-template <typename V>
-void VisitHillaireEvaluatorTables(HillaireEvaluator& e, V& v) {
-    v(e.transmittance);
-    v(e.multiple_scattering);
-    v(e.sky_view);
-    v(e.ap_scatter);
-    v(e.ap_transmittance);
-}
-
 // Transmittance table (256 x 64 RGB): seed 004
 // ComputeTransmittanceToTopAtmosphereBoundaryTexture, optical depth by the
 // midpoint rule with `steps` segments. Item: one texel (x fastest).
@@ -79,7 +68,7 @@ struct HillaireMultipleScatteringStage {
 
     template <typename V>
     void VisitTables(V& v) {
-        VisitHillaireEvaluatorTables(e, v);
+        e.VisitTables(v);
         v(out);
     }
     ATMOS_HD void operator()(int64_t index) const {
@@ -152,7 +141,7 @@ struct HillaireSkyViewStage {
 
     template <typename V>
     void VisitTables(V& v) {
-        VisitHillaireEvaluatorTables(e, v);
+        e.VisitTables(v);
         v(out);
     }
     ATMOS_HD void operator()(int64_t item) const {
@@ -192,7 +181,7 @@ struct HillaireAerialPerspectiveStage {
 
     template <typename V>
     void VisitTables(V& v) {
-        VisitHillaireEvaluatorTables(e, v);
+        e.VisitTables(v);
         v(scatter);
         v(transmittance);
     }

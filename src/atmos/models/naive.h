@@ -29,11 +29,11 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
+#include "models/evaluator_model.h"
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
 #include "physics/single_scattering.h"
-#include "render/render.h"
 
 namespace atmos {
 
@@ -85,10 +85,7 @@ class NaiveModel : public SimpleEvaluatorModel<NaiveModel, NaiveEvaluator> {
     static const OptionTable<NaiveOptions>& OptionRows();
     explicit NaiveModel(const NaiveOptions& options);
     static ModelInfo StaticInfo();
-    void Prepare(const AtmosphereParameters& atmosphere) override {
-        atm_ = atmosphere;
-        evaluator_.atm = atmosphere;
-    }
+    void Prepare(const AtmosphereParameters& atmosphere) override { SetAtmosphere(atmosphere); }
 };
 
 }  // namespace atmos

@@ -304,7 +304,7 @@ NeuralModel::NeuralModel(const NeuralOptions& options) {
 }
 
 void NeuralModel::Prepare(const AtmosphereParameters& atmosphere) {
-    atm_ = atmosphere;
+    SetAtmosphere(atmosphere);
     NeuralWeights w;
     std::string source;
     if (!weights_path_.empty()) {

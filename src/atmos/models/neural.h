@@ -35,9 +35,9 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
+#include "models/evaluator_model.h"
 #include "models/neural_net.h"
 #include "physics/geometry.h"
-#include "render/render.h"
 
 namespace atmos {
 

@@ -53,7 +53,7 @@ OneilModel::OneilModel(const OneilOptions& options) {
 }
 
 void OneilModel::Prepare(const AtmosphereParameters& atmosphere) {
-    atm_ = atmosphere;
+    SetAtmosphere(atmosphere);
     evaluator_.optics = MakeOneilOptics(atmosphere, refit_);
 }
 

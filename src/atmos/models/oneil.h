@@ -50,11 +50,11 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
+#include "models/evaluator_model.h"
 #include "physics/analytic_media.h"
 #include "physics/analytic_optical_depth.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
-#include "render/render.h"
 
 namespace atmos {
 

@@ -52,7 +52,7 @@ PreethamModel::PreethamModel(const PreethamOptions& options) {
 }
 
 void PreethamModel::Prepare(const AtmosphereParameters& atmosphere) {
-    atm_ = atmosphere;
+    SetAtmosphere(atmosphere);
     evaluator_.bottom = atmosphere.bottom_radius;
     evaluator_.top = atmosphere.top_radius;
 }

@@ -33,8 +33,8 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
+#include "models/evaluator_model.h"
 #include "physics/geometry.h"
-#include "render/render.h"
 
 namespace atmos {
 

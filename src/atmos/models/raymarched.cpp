@@ -26,7 +26,7 @@ RaymarchedModel::RaymarchedModel(const RaymarchedOptions& options) {
 }
 
 void RaymarchedModel::Prepare(const AtmosphereParameters& atmosphere) {
-    atm_ = atmosphere;
+    SetAtmosphere(atmosphere);
     evaluator_.optics.m = MakeAnalyticMedia(atmosphere);
 }
 

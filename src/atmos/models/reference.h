@@ -58,13 +58,13 @@
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "base/rng.h"
+#include "models/evaluator_model.h"
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
 #include "physics/sampling.h"
 #include "physics/transmittance.h"
 #include "render/progressive.h"
-#include "render/render.h"
 
 namespace atmos {
 

@@ -1,29 +1,14 @@
-// atmos: THE list of models. Adding a model = one entry here.
+// atmos: the registry of models, built from THE list (models/model_list.h).
 #include <functional>
 #include <memory>
 #include <string>
+#include <typeindex>
+#include <typeinfo>
 #include <vector>
 
 #include "atmos/error.h"
 #include "atmos/model.h"
-#include "models/atmosphere_plus.h"
-#include "models/bruneton.h"
-#include "models/empty.h"
-#include "models/flat.h"
-#include "models/hillaire.h"
-#include "models/naive.h"
-#include "models/neural.h"
-#include "models/oneil.h"
-#include "models/preetham.h"
-#include "models/raymarched.h"
-#include "models/reference.h"
-#include "models/schuler.h"
-#include "models/transmittance_chapman.h"
-#include "models/transmittance_erfc.h"
-#include "models/transmittance_flat.h"
-#include "models/transmittance_oneil.h"
-#include "models/transmittance_polynomial.h"
-#include "models/transmittance_reference.h"
+#include "models/model_list.h"
 
 namespace atmos {
 
@@ -56,24 +41,9 @@ Entry MakeEntry() {
 
 const std::vector<Entry>& Registry() {
     static const std::vector<Entry> entries = {
-        MakeEntry<EmptyModel>(),
-        MakeEntry<NaiveModel>(),
-        MakeEntry<ReferenceModel>(),
-        MakeEntry<OneilModel>(),
-        MakeEntry<SchulerModel>(),
-        MakeEntry<FlatModel>(),
-        MakeEntry<RaymarchedModel>(),
-        MakeEntry<PreethamModel>(),
-        MakeEntry<TransmittanceReferenceModel>(),
-        MakeEntry<TransmittanceFlatModel>(),
-        MakeEntry<TransmittanceErfcModel>(),
-        MakeEntry<TransmittanceChapmanModel>(),
-        MakeEntry<TransmittanceOneilModel>(),
-        MakeEntry<TransmittancePolynomialModel>(),
-        MakeEntry<HillaireModel>(),
-        MakeEntry<BrunetonModel>(),
-        MakeEntry<AtmospherePlusModel>(),
-        MakeEntry<NeuralModel>(),
+#define ATMOS_REGISTRY_ENTRY(M, E) MakeEntry<M>(),
+        ATMOS_MODELS(ATMOS_REGISTRY_ENTRY)
+#undef ATMOS_REGISTRY_ENTRY
     };
     return entries;
 }
@@ -99,6 +69,18 @@ ModelInfo EmptyModel::StaticInfo() {
 }
 
 std::vector<ModelInfo> ListModels() { return Infos(); }
+
+bool HasDeviceKernels(const std::type_info& evaluator) {
+    static const std::vector<std::type_index> listed = {
+#define ATMOS_DEVICE_EVALUATOR(M, E) std::type_index(typeid(E)),
+        ATMOS_MODELS(ATMOS_DEVICE_EVALUATOR)
+#undef ATMOS_DEVICE_EVALUATOR
+    };
+    for (const std::type_index& t : listed) {
+        if (t == std::type_index(evaluator)) return true;
+    }
+    return false;
+}
 
 const ModelInfo& GetModelInfo(const std::string& name) {
     for (const ModelInfo& info : Infos()) {

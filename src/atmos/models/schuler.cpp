@@ -32,8 +32,7 @@ SchulerModel::SchulerModel(const SchulerOptions& options) {
 }
 
 void SchulerModel::Prepare(const AtmosphereParameters& atmosphere) {
-    atm_ = atmosphere;
-    evaluator_.atm = atmosphere;
+    SetAtmosphere(atmosphere);
     evaluator_.m = MakeAnalyticMedia(atmosphere);
 }
 

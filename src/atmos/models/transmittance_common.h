@@ -14,8 +14,8 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
+#include "models/evaluator_model.h"
 #include "physics/geometry.h"
-#include "render/render.h"
 
 namespace atmos {
 
@@ -49,7 +49,7 @@ template <typename Derived, typename Optics>
 class TransmittanceModel : public SimpleEvaluatorModel<Derived, TransmittanceEvaluator<Optics>> {
   public:
     void Prepare(const AtmosphereParameters& atmosphere) override {
-        this->atm_ = atmosphere;
+        this->SetAtmosphere(atmosphere);
         this->evaluator_.bottom = atmosphere.bottom_radius;
         this->evaluator_.top = atmosphere.top_radius;
         this->evaluator_.optics = static_cast<const Derived&>(*this).MakeOptics(atmosphere);

@@ -18,7 +18,7 @@
 #include "atmos/math.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
-#include "render/render.h"
+#include "physics/ray.h"
 
 namespace atmos {
 

@@ -21,13 +21,9 @@ PixelSetup MakePixelSetup(const RenderRequest& request, const AtmosphereParamete
     return s;
 }
 
-void FailNoDeviceKernels(bool has_cuda) {
-    if (!has_cuda) {
-        Fail("--backend cuda: this build has no CUDA support; configure with -DATMOS_CUDA=ON");
-    }
-    Fail(
-        "--backend cuda: this model's evaluator has no CUDA kernels (add it to "
-        "src/atmos/render/device_evaluators.h)");
+void FailNoDeviceKernels(const char* evaluator) {
+    Fail("device backend: evaluator ", evaluator,
+         " has no device kernels (its model is not in src/atmos/models/model_list.h)");
 }
 
 }  // namespace atmos

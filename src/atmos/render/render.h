@@ -1,28 +1,23 @@
-// atmos: THE per-pixel loop.
+// atmos: THE per-pixel and per-query loops.
 //
 // ShadePixel() is the one per-pixel function (ATMOS_HD): it asks a model's
-// evaluator for the view ray's sky radiance, ground radiance and transmittance
-// and composes the pixel. RenderImage() runs it over an image on the CPU
-// (tiles, in parallel); the CUDA build launches the same ShadePixel() per thread
-// (src/atmos/cuda). Models never see pixels.
-//
-// Evaluator contract (duck-typed, trivially copyable, every member ATMOS_HD):
-//   RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
-//                      bool want_ground) const;
-// returning, per unit of solar irradiance, the light scattered into the ray by
-// the atmosphere, the light reflected by the ground where the ray ends
-// (attenuated to the camera; only when want_ground), and the transmittance of
-// the ray's segment through the atmosphere (to the ground, or to space).
-//
-// Monte Carlo evaluators declare `static constexpr bool kStochastic = true` and
-// implement instead
-//   RayResult EvaluateKeyed(camera, dir, sun, want_ground, uint64_t key) const;
-// where `key` identifies the pixel (or query) so that random numbers depend on
-// the pixel and sample index only (src/atmos/base/rng.h).
+// evaluator (the per-ray contract of physics/ray.h) for the view ray's sky
+// radiance, ground radiance and transmittance and composes the pixel.
+// SampleOne() is the one per-query function of the sample contract.
+// RenderImage() and SampleAll() launch them through the one loop of the
+// project, RunStage (render/stages.h), as the stages RenderStage (one item per
+// pixel) and SampleStage (one item per query): that loop picks the backend
+// (CPU: ParallelFor; CUDA: one thread per item, src/atmos/cuda/render_kernels.cu
+// instantiates both stages for every evaluator of models/model_list.h;
+// emulated device: the CUDA bookkeeping on the host), copies the evaluator's
+// tables (those its VisitTables names) to the device through the current
+// StageSession, and logs each launch ("render", "sample") in the stage log.
+// Models never see pixels; the host adapters that turn an evaluator into a
+// Model are in models/evaluator_model.h.
 #pragma once
 
 #include <cstdint>
-#include <type_traits>
+#include <typeinfo>
 #include <vector>
 
 #include "atmos/image.h"
@@ -32,29 +27,10 @@
 #include "base/parallel.h"
 #include "base/progress.h"
 #include "physics/geometry.h"
-#include "render/device_evaluators.h"
+#include "physics/ray.h"
+#include "render/stages.h"
 
 namespace atmos {
-
-struct RayResult {
-    Rgb sky;            // in-scattered radiance per unit solar irradiance
-    Rgb ground;         // reflected ground radiance reaching the camera, same units
-    Rgb transmittance;  // of the segment inside the atmosphere
-    bool hits_ground = false;
-};
-
-// The opening every evaluator shares: clips the ray camera + t dir to the
-// atmosphere shell [bottom, top] into *seg and resets *out (transmittance 1,
-// hits_ground from the clip). Returns false when the ray does not cross the
-// atmosphere: *out is then the whole answer (L = 0, T = 1).
-ATMOS_HD inline bool BeginRay(const Vec3d& camera, const Vec3d& dir, double bottom, double top,
-                              RayResult* out, AtmosphereSegment* seg) {
-    *out = RayResult();
-    out->transmittance = Rgb(1.0f);
-    *seg = ClipToAtmosphere(camera, dir, bottom, top);
-    out->hits_ground = seg->hits_ground;
-    return seg->inside;
-}
 
 // Everything ShadePixel needs, trivially copyable (device-friendly).
 struct PixelSetup {
@@ -71,25 +47,6 @@ struct PixelSetup {
 
 PixelSetup MakePixelSetup(const RenderRequest& request, const AtmosphereParameters& atmosphere);
 
-// True for evaluators that declare kStochastic (they take a pixel key).
-template <typename E, typename = void>
-struct IsStochastic : std::false_type {};
-template <typename E>
-struct IsStochastic<E, std::void_t<decltype(E::kStochastic)>>
-    : std::integral_constant<bool, E::kStochastic> {};
-
-template <typename Evaluator>
-ATMOS_HD inline RayResult EvaluateRay(const Evaluator& evaluator, const Vec3d& camera,
-                                      const Vec3d& dir, const Vec3d& sun, bool want_ground,
-                                      uint64_t key) {
-    if constexpr (IsStochastic<Evaluator>::value) {
-        return evaluator.EvaluateKeyed(camera, dir, sun, want_ground, key);
-    } else {
-        (void)key;
-        return evaluator.Evaluate(camera, dir, sun, want_ground);
-    }
-}
-
 template <typename Evaluator>
 ATMOS_HD inline Rgb ShadePixel(const Evaluator& evaluator, const PixelSetup& s, int x, int y) {
     const Vec3d dir = s.camera.RayDirection(x, y, s.width, s.height);
@@ -103,61 +60,6 @@ ATMOS_HD inline Rgb ShadePixel(const Evaluator& evaluator, const PixelSetup& s, 
         radiance += s.irradiance * r.transmittance * s.sun_disc_scale;
     }
     return SanitizeRadiance(radiance);
-}
-
-#if defined(ATMOS_HAS_CUDA)
-namespace cuda {
-// Defined (and instantiated for ATMOS_DEVICE_EVALUATORS) in
-// src/atmos/cuda/render_kernels.cu. Both copy the evaluator's tables to the
-// device, run the kernel and copy the result back; throw atmos::Error on a
-// CUDA error.
-template <typename Evaluator>
-void RenderImageDevice(const Evaluator& evaluator, const PixelSetup& setup, ImageView out);
-template <typename Evaluator>
-void SampleAllDevice(const Evaluator& evaluator, double bottom_radius, const SampleQuery* queries,
-                     size_t count, SampleAnswer* answers);
-}  // namespace cuda
-#endif
-
-// Throws the error of a device loop that cannot run: no CUDA in this build, or
-// an evaluator without kernels (render/render.cpp).
-[[noreturn]] void FailNoDeviceKernels(bool has_cuda);
-
-// Renders every pixel of `out` (already sized s.width x s.height): on the CPU
-// (the default), 16 x 16 tiles in parallel; each pixel depends on its
-// coordinates only, so the image is the same for any thread count. On the
-// CUDA backend, one thread per pixel on the device.
-// `progress` (may be null) is advanced by one per pixel.
-template <typename Evaluator>
-void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView out,
-                 Progress* progress) {
-    if (CurrentBackend() == Backend::kCuda) {
-#if defined(ATMOS_HAS_CUDA)
-        if constexpr (HasDeviceKernels<Evaluator>::value) {
-            cuda::RenderImageDevice(evaluator, setup, out);
-            if (progress) progress->Add(static_cast<int64_t>(setup.width) * setup.height);
-            return;
-        } else {
-            FailNoDeviceKernels(true);
-        }
-#else
-        FailNoDeviceKernels(false);
-#endif
-    }
-    constexpr int kTile = 16;
-    ParallelForTiles(setup.width, setup.height, kTile, [&](int x0, int y0, int x1, int y1) {
-        for (int y = y0; y < y1; ++y) {
-            for (int x = x0; x < x1; ++x) out.Set(x, y, ShadePixel(evaluator, setup, x, y));
-        }
-        if (progress) progress->Add(static_cast<int64_t>(x1 - x0) * (y1 - y0));
-    });
-}
-
-template <typename Evaluator>
-void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView out,
-                 bool show_progress) {
-    Progress progress("render", static_cast<int64_t>(setup.width) * setup.height, show_progress);
-    RenderImage(evaluator, setup, out, &progress);
 }
 
 // The sample contract of DESIGN.md for one query, through an evaluator.
@@ -177,64 +79,112 @@ ATMOS_HD inline SampleAnswer SampleOne(const Evaluator& evaluator, double bottom
     return a;
 }
 
+// Throws the error of a device launch that cannot run: an evaluator without
+// device kernels (not in models/model_list.h; render/render.cpp).
+[[noreturn]] void FailNoDeviceKernels(const char* evaluator);
+// True for the evaluators of models/model_list.h (defined from the list in
+// models/registry.cpp): the ones the CUDA build has kernels for.
+bool HasDeviceKernels(const std::type_info& evaluator);
+
+// One pixel per item (x fastest): the render as a stage of RunStage.
+template <typename Evaluator>
+struct RenderStage {
+    Evaluator evaluator;
+    PixelSetup setup;
+    TableOut out;  // the image: width x height x 3, written whole
+    // Its output and any id-0 view are copied back and dropped from the
+    // session after the launch (render/stages.h).
+    static constexpr bool kTransient = true;
+    template <typename V>
+    void VisitTables(V& v) {
+        VisitEvaluatorTables(evaluator, v);
+        v(out);
+    }
+    ATMOS_HD void operator()(int64_t item) const {
+        const int x = static_cast<int>(item % setup.width);
+        const int y = static_cast<int>(item / setup.width);
+        const ImageView image{out.data, setup.width, setup.height};
+        image.Set(x, y, ShadePixel(evaluator, setup, x, y));
+    }
+};
+
+// One query per item: SampleAll as a stage of RunStage. The queries and
+// answers travel as float tables (id 0: transient).
+template <typename Evaluator>
+struct SampleStage {
+    static_assert(sizeof(SampleQuery) % sizeof(float) == 0, "queries travel as floats");
+    static_assert(sizeof(SampleAnswer) % sizeof(float) == 0, "answers travel as floats");
+    Evaluator evaluator;
+    double bottom_radius = 0.0;
+    TableView queries;
+    TableOut answers;
+    static constexpr bool kTransient = true;
+    template <typename V>
+    void VisitTables(V& v) {
+        VisitEvaluatorTables(evaluator, v);
+        v(queries);
+        v(answers);
+    }
+    ATMOS_HD void operator()(int64_t item) const {
+        const SampleQuery* q = reinterpret_cast<const SampleQuery*>(queries.data);
+        SampleAnswer* a = reinterpret_cast<SampleAnswer*>(answers.data);
+        a[item] = SampleOne(evaluator, bottom_radius, q[item], static_cast<uint64_t>(item));
+    }
+};
+// Every evaluator but host-only ones (physics/ray.h) has both launches on the
+// device: render_kernels.cu instantiates them for the evaluators of
+// models/model_list.h, so a CUDA build of a model missing from the list fails
+// to link.
+template <typename E>
+struct HasDeviceStage<RenderStage<E>> : std::bool_constant<!IsHostOnly<E>::value> {};
+template <typename E>
+struct HasDeviceStage<SampleStage<E>> : std::bool_constant<!IsHostOnly<E>::value> {};
+
+// Renders every pixel of `out` (already sized s.width x s.height) through
+// RunStage("render", ...): each pixel depends on its coordinates only, so the
+// image is the same for any backend schedule and thread count. `progress`
+// (may be null) is advanced by one per pixel.
+template <typename Evaluator>
+void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView out,
+                 Progress* progress) {
+    if (IsDeviceBackend(CurrentBackend()) && !HasDeviceKernels(typeid(Evaluator))) {
+        FailNoDeviceKernels(typeid(Evaluator).name());
+    }
+    RenderStage<Evaluator> stage{evaluator, setup, {}};
+    stage.out.data = out.data;
+    stage.out.width = out.width;
+    stage.out.height = out.height;
+    stage.out.channels = 3;
+    RunStage("render", static_cast<int64_t>(setup.width) * setup.height, 256, stage, progress);
+}
+
+template <typename Evaluator>
+void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView out,
+                 bool show_progress) {
+    Progress progress("render", static_cast<int64_t>(setup.width) * setup.height, show_progress);
+    RenderImage(evaluator, setup, out, &progress);
+}
+
+// Answers every query through RunStage("sample", ...).
 template <typename Evaluator>
 std::vector<SampleAnswer> SampleAll(const Evaluator& evaluator, double bottom_radius,
                                     const std::vector<SampleQuery>& queries) {
     std::vector<SampleAnswer> answers(queries.size());
-    if (CurrentBackend() == Backend::kCuda) {
-#if defined(ATMOS_HAS_CUDA)
-        if constexpr (HasDeviceKernels<Evaluator>::value) {
-            cuda::SampleAllDevice(evaluator, bottom_radius, queries.data(), queries.size(),
-                                  answers.data());
-            return answers;
-        } else {
-            FailNoDeviceKernels(true);
-        }
-#else
-        FailNoDeviceKernels(false);
-#endif
+    if (queries.empty()) return answers;
+    if (IsDeviceBackend(CurrentBackend()) && !HasDeviceKernels(typeid(Evaluator))) {
+        FailNoDeviceKernels(typeid(Evaluator).name());
     }
-    ParallelFor(static_cast<int64_t>(queries.size()), 64, [&](int64_t i) {
-        answers[static_cast<size_t>(i)] = SampleOne(
-            evaluator, bottom_radius, queries[static_cast<size_t>(i)], static_cast<uint64_t>(i));
-    });
+    SampleStage<Evaluator> stage{evaluator, bottom_radius, {}, {}};
+    constexpr int kQueryFloats = sizeof(SampleQuery) / sizeof(float);
+    constexpr int kAnswerFloats = sizeof(SampleAnswer) / sizeof(float);
+    stage.queries.data = reinterpret_cast<const float*>(queries.data());
+    stage.queries.width = static_cast<int>(queries.size());
+    stage.queries.channels = kQueryFloats;
+    stage.answers.data = reinterpret_cast<float*>(answers.data());
+    stage.answers.width = static_cast<int>(answers.size());
+    stage.answers.channels = kAnswerFloats;
+    RunStage("sample", static_cast<int64_t>(queries.size()), 64, stage);
     return answers;
 }
-
-// Host-side base for models with one evaluator: Render and Sample are written
-// once here. Derived implements `Evaluator MakeEvaluator() const` and
-// `const AtmosphereParameters& atmosphere() const`.
-template <typename Derived>
-class EvaluatorModel : public Model {
-  public:
-    void Render(const RenderRequest& request, Image* out) const override {
-        const Derived& self = static_cast<const Derived&>(*this);
-        const PixelSetup setup = MakePixelSetup(request, self.atmosphere());
-        out->Resize(request.width, request.height);
-        RenderImage(self.MakeEvaluator(), setup, out->View(), request.show_progress);
-    }
-    std::vector<SampleAnswer> Sample(const std::vector<SampleQuery>& queries) const override {
-        const Derived& self = static_cast<const Derived&>(*this);
-        return SampleAll(self.MakeEvaluator(), self.atmosphere().bottom_radius, queries);
-    }
-};
-
-// The state most evaluator models are: their ModelInfo, the atmosphere of the
-// last Prepare() and one evaluator, handed out by value. Derived provides
-// `static ModelInfo StaticInfo()`, its constructor (from its options) and
-// Prepare(), which sets atm_ and fills evaluator_.
-template <typename Derived, typename Evaluator>
-class SimpleEvaluatorModel : public EvaluatorModel<Derived> {
-  public:
-    const ModelInfo& Info() const override { return info_; }
-    Evaluator MakeEvaluator() const { return evaluator_; }
-    const AtmosphereParameters& atmosphere() const { return atm_; }
-
-  protected:
-    SimpleEvaluatorModel() : info_(Derived::StaticInfo()), atm_(EarthAtmosphere()) {}
-    ModelInfo info_;
-    AtmosphereParameters atm_;
-    Evaluator evaluator_;
-};
 
 }  // namespace atmos

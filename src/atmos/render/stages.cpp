@@ -1,5 +1,6 @@
 #include "render/stages.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -76,21 +77,36 @@ StageSession* CurrentStageSession() { return g_session.load(); }
 
 StageSession::StageSession() {
     const Backend backend = CurrentBackend();
+    StageSession* current = g_session.load();
+    if (current && current->active() && current->backend() == backend) {
+        parent_ = current;
+        while (parent_->parent_) parent_ = parent_->parent_;
+        return;
+    }
+    backend_ = backend;
     if (IsDeviceBackend(backend)) memory_ = MakeStageMemory(backend);
     previous_ = g_session.exchange(this);
 }
 
+StageSession::StageSession(Detached) : detached_(true) {
+    backend_ = CurrentBackend();
+    if (IsDeviceBackend(backend_)) memory_ = MakeStageMemory(backend_);
+}
+
+StageSession* StageSession::Enter(StageSession* session) { return g_session.exchange(session); }
+void StageSession::Leave(StageSession* previous) { g_session.store(previous); }
+
+bool StageSession::emulated() const {
+    const StageSession* r = root();
+    return r->memory_ && r->memory_->emulated();
+}
+
 StageSession::~StageSession() {
-    g_session.store(previous_);
+    if (parent_) return;
+    if (!detached_) g_session.store(previous_);
     if (memory_) {
         for (Entry& e : entries_) memory_->Free(e.device);
-        if (CurrentStageLog() && session_downloads_ > 0) {
-            StageTime t;
-            t.name = "downloads";
-            t.backend = memory_->emulated() ? "emulated-device" : "cuda";
-            t.bytes_down = session_downloads_;
-            LogStage(t);
-        }
+        LogDownloads();
     }
 }
 
@@ -102,6 +118,7 @@ StageSession::Entry* StageSession::Find(const float* host, uint64_t id) {
 }
 
 void StageSession::Download(Table* table) {
+    if (parent_) return parent_->Download(table);
     if (!memory_ || !table->size()) return;
     Entry* e = Find(table->data(), table->id());
     if (!e || !e->device_newer) return;
@@ -112,6 +129,7 @@ void StageSession::Download(Table* table) {
 }
 
 void StageSession::HostWrote(const Table& table) {
+    if (parent_) return parent_->HostWrote(table);
     if (!memory_) return;
     Entry* e = Find(table.data(), table.id());
     if (!e) return;
@@ -126,6 +144,7 @@ void StageSession::HostWrote(const Table& table) {
 
 void StageSession::Acquire(const char* stage, const std::vector<StageTableRef>& refs,
                            std::vector<float*>* device) {
+    if (parent_) return parent_->Acquire(stage, refs, device);
     device->clear();
     for (const StageTableRef& r : refs) {
         Entry* e = Find(r.host, r.id);
@@ -161,6 +180,7 @@ void StageSession::Acquire(const char* stage, const std::vector<StageTableRef>& 
 }
 
 void StageSession::Produced(const std::vector<StageTableRef>& refs) {
+    if (parent_) return parent_->Produced(refs);
     for (const StageTableRef& r : refs) {
         if (!r.output) continue;
         Entry* e = Find(r.host, r.id);
@@ -173,6 +193,7 @@ void StageSession::Produced(const std::vector<StageTableRef>& refs) {
 }
 
 void StageSession::DownloadOutputs(const std::vector<StageTableRef>& refs) {
+    if (parent_) return parent_->DownloadOutputs(refs);
     for (const StageTableRef& r : refs) {
         if (!r.output) continue;
         Entry* e = Find(r.host, r.id);
@@ -181,6 +202,90 @@ void StageSession::DownloadOutputs(const std::vector<StageTableRef>& refs) {
         downloaded_bytes_ += static_cast<int64_t>(r.floats * sizeof(float));
         e->device_newer = false;
     }
+}
+
+void StageSession::LogDownloads() {
+    if (parent_) return parent_->LogDownloads();
+    if (!memory_ || session_downloads_ == 0) return;
+    if (CurrentStageLog()) {
+        StageTime t;
+        t.name = "downloads";
+        t.backend = memory_->emulated() ? "emulated-device" : "cuda";
+        t.bytes_down = session_downloads_;
+        LogStage(t);
+    }
+    session_downloads_ = 0;
+}
+
+void StageSession::ForgetViews(const std::vector<StageTableRef>& refs) {
+    if (parent_) return parent_->ForgetViews(refs);
+    for (const StageTableRef& r : refs) {
+        if (r.id != 0) continue;
+        for (size_t i = 0; i < entries_.size(); ++i) {
+            if (entries_[i].id == 0 && entries_[i].host == r.host) {
+                memory_->Free(entries_[i].device);
+                entries_.erase(entries_.begin() + static_cast<std::ptrdiff_t>(i));
+                break;
+            }
+        }
+    }
+}
+
+void StageSession::KeepOnly(const std::vector<uint64_t>& ids) {
+    if (parent_) return parent_->KeepOnly(ids);
+    std::vector<Entry> kept;
+    for (Entry& e : entries_) {
+        if (e.id != 0 && std::find(ids.begin(), ids.end(), e.id) != ids.end()) {
+            kept.push_back(e);
+        } else {
+            memory_->Free(e.device);
+        }
+    }
+    entries_ = std::move(kept);
+}
+
+// A TableView at an 8-byte aligned offset looks like: a non-null pointer, a
+// shape of 1..2^24 texels per axis with 1..4 channels, and the id of a Table
+// of this process.
+void StageSession::CheckNamedTables(const char* stage, const unsigned char* bytes, size_t size,
+                                    const std::vector<size_t>& named) const {
+    const uint64_t last_id = Table::LastId();
+    for (size_t off = 0; off + sizeof(TableView) <= size; off += alignof(TableView)) {
+        bool overlaps_named = false;
+        for (size_t i = 0; i + 1 < named.size(); i += 2) {
+            overlaps_named = overlaps_named ||
+                             (off + sizeof(TableView) > named[i] && off < named[i] + named[i + 1]);
+        }
+        if (overlaps_named) continue;
+        TableView v;
+        std::memcpy(&v, bytes + off, sizeof v);
+        const int kMax = 1 << 24;
+        if (v.data && v.id >= 1 && v.id <= last_id && v.width >= 1 && v.width <= kMax &&
+            v.height >= 1 && v.height <= kMax && v.depth >= 1 && v.depth <= kMax &&
+            v.channels >= 1 && v.channels <= 4) {
+            Fail("device launch '", stage, "': the stage holds a table (id ", v.id, ", ", v.width,
+                 " x ", v.height, " x ", v.depth, " x ", v.channels, ", at byte ", off,
+                 ") that its VisitTables does not name: the device would read it through a host "
+                 "pointer");
+        }
+    }
+}
+
+ResidentScope::ResidentScope(ResidentTables* tables) {
+    const Backend backend = CurrentBackend();
+    if (!IsDeviceBackend(backend)) return;
+    if (!tables->session_ || tables->session_->backend() != backend) {
+        tables->session_ = std::make_unique<StageSession>(StageSession::Detached{});
+    }
+    session_ = tables->session_.get();
+    previous_ = StageSession::Enter(session_);
+}
+
+ResidentScope::~ResidentScope() {
+    if (!session_) return;
+    StageSession::Leave(previous_);
+    session_->KeepOnly(keep_);
+    session_->LogDownloads();
 }
 
 }  // namespace atmos

@@ -1,6 +1,7 @@
-// atmos: THE loop of the precomputations (the tables of bruneton, hillaire,
-// atmosphere-plus), on the CPU or, in a CUDA build, on the device, from the
-// same source.
+// atmos: THE loop of the project (RunStage): the precomputations (the tables
+// of bruneton, hillaire, atmosphere-plus), the renders and the samples
+// (render/render.h: RenderStage, SampleStage), on the CPU or, in a CUDA build,
+// on the device, from the same source, all timed in one log.
 //
 // A stage is a trivially copyable struct:
 //
@@ -44,9 +45,28 @@
 // catch (tests poison the host tables themselves for that, e.g.
 // tests/bruneton_stages_test.cpp).
 //
-// A StageLogScope collects, per stage run, the name, item count and the time:
-// wall time on the CPU; on the device, the kernel alone between CUDA events
-// and the whole call with the copies (`atmos bench` prints them).
+// Joining and resident sessions. A StageSession made while another is current
+// (on the same device backend) joins it: its calls go to the current one and
+// it frees nothing. A model keeps its tables on the device from Prepare() to
+// its renders with a ResidentTables member: a ResidentScope makes the model's
+// own session current for a Prepare, Render or Sample (the precomputation's
+// sessions join it), and on exit keeps only the device copies of the tables
+// its evaluator names (Keep), so a second render uploads nothing.
+//
+// Transient stages (`static constexpr bool kTransient = true`: the render and
+// sample launches) have their outputs copied back after the run, and their
+// id-0 views (memory that is not a Table: the image, the queries) dropped
+// from the session.
+//
+// On the emulated device, every stage copy is also checked, after its tables
+// are re-pointed, for a TableView its VisitTables does not name (a table the
+// device would read through a host pointer): one clear error.
+//
+// A StageLogScope collects, per stage run (every RunStage: precomputation
+// stages, "render" and "sample"), the name, item count, backend, the time
+// (wall time on the CPU; on the device, the kernel alone between CUDA events
+// and the whole call with the copies) and the bytes copied: the one timing log
+// of the project (`atmos bench` prints it and writes its stages CSV from it).
 #pragma once
 
 #include <chrono>
@@ -57,13 +77,22 @@
 #include <vector>
 
 #include "base/parallel.h"
+#include "base/progress.h"
 #include "base/texture.h"
+#include "physics/ray.h"
 
 namespace atmos {
 
 // True for stages with device code (ATMOS_DEVICE_STAGE).
 template <typename Stage>
 struct HasDeviceStage : std::false_type {};
+
+// True for stages that declare kTransient (see the top of this file).
+template <typename S, typename = void>
+struct IsTransientStage : std::false_type {};
+template <typename S>
+struct IsTransientStage<S, std::void_t<decltype(S::kTransient)>>
+    : std::integral_constant<bool, S::kTransient> {};
 
 // Declares, next to a stage's definition (at namespace atmos scope), that a .cu
 // file instantiates it with ATMOS_INSTANTIATE_DEVICE_STAGE. A stage declared
@@ -129,8 +158,12 @@ struct StageTableRef {
 // the CPU backend. Process-wide while alive (the innermost is current).
 class StageSession {
   public:
-    StageSession();
+    StageSession();   // joins the current session, or opens one (current while alive)
     ~StageSession();  // frees the device copies; copies nothing back
+    // A session that is not made current (ResidentTables): ResidentScope
+    // makes it current.
+    struct Detached {};
+    explicit StageSession(Detached);
     StageSession(const StageSession&) = delete;
     StageSession& operator=(const StageSession&) = delete;
 
@@ -147,9 +180,27 @@ class StageSession {
     void Produced(const std::vector<StageTableRef>& refs);
     // Copies every output of `refs` back (a run outside any session).
     void DownloadOutputs(const std::vector<StageTableRef>& refs);
-    bool active() const { return memory_ != nullptr; }
-    int64_t uploaded_bytes() const { return uploaded_bytes_; }
-    int64_t downloaded_bytes() const { return downloaded_bytes_; }
+    // Drops the device copies of `refs` whose id is 0 (transient launches).
+    void ForgetViews(const std::vector<StageTableRef>& refs);
+    // Drops every device copy but those of tables with an id in `ids`.
+    void KeepOnly(const std::vector<uint64_t>& ids);
+    // Fails when `stage_bytes` (a stage copy whose named tables were
+    // re-pointed) still holds a host TableView that is not one of the named
+    // ones (`named_offsets`: pairs of offset and size; emulated device only,
+    // see the top of this file).
+    void CheckNamedTables(const char* stage, const unsigned char* stage_bytes, size_t size,
+                          const std::vector<size_t>& named_offsets) const;
+    bool active() const { return root()->memory_ != nullptr; }
+    bool emulated() const;
+    Backend backend() const { return root()->backend_; }
+    int64_t uploaded_bytes() const { return root()->uploaded_bytes_; }
+    int64_t downloaded_bytes() const { return root()->downloaded_bytes_; }
+    // Logs the bytes of the Download() calls since the last such entry as one
+    // "downloads" entry (when there were any, and a log is installed).
+    void LogDownloads();
+    // Makes `session` current; returns the one it replaces (for Leave).
+    static StageSession* Enter(StageSession* session);
+    static void Leave(StageSession* previous);
 
   private:
     struct Entry {
@@ -160,6 +211,10 @@ class StageSession {
         bool device_newer;
     };
     Entry* Find(const float* host, uint64_t id);
+    const StageSession* root() const { return parent_ ? parent_ : this; }
+    StageSession* parent_ = nullptr;  // the session this one joined
+    bool detached_ = false;
+    Backend backend_ = Backend::kCpu;
     int64_t session_downloads_ = 0;  // bytes of Download() calls (logged at the end)
     std::unique_ptr<StageMemory> memory_;
     std::vector<Entry> entries_;
@@ -167,6 +222,37 @@ class StageSession {
     int64_t uploaded_bytes_ = 0, downloaded_bytes_ = 0;
 };
 StageSession* CurrentStageSession();
+
+// A model's device copies, kept from Prepare() to its renders (see the top of
+// this file). Reset() drops them all.
+class ResidentTables {
+  public:
+    void Reset() { session_.reset(); }
+    StageSession* session() const { return session_.get(); }
+
+  private:
+    friend class ResidentScope;
+    std::unique_ptr<StageSession> session_;
+};
+
+// Makes a model's resident session current while alive (on a device backend;
+// inert on the CPU). On exit, only the tables named by Keep() stay on the
+// device.
+class ResidentScope {
+  public:
+    explicit ResidentScope(ResidentTables* tables);
+    ~ResidentScope();
+    ResidentScope(const ResidentScope&) = delete;
+    ResidentScope& operator=(const ResidentScope&) = delete;
+    // Keeps the device copies of the tables `evaluator` names (VisitTables).
+    template <typename Evaluator>
+    void Keep(const Evaluator& evaluator);
+
+  private:
+    StageSession* session_ = nullptr;
+    StageSession* previous_ = nullptr;
+    std::vector<uint64_t> keep_;
+};
 
 // Collects the tables a stage names; then re-points them to device copies.
 struct CollectStageTables {
@@ -179,6 +265,30 @@ struct CollectStageTables {
     }
     void operator()(TableOut& o) const {
         if (o.data) refs->push_back({o.data, o.size(), o.id, true, o.accumulate});
+    }
+};
+// The byte offsets, inside a stage, of the tables its VisitTables names.
+struct NamedTableOffsets {
+    const unsigned char* base;
+    std::vector<size_t>* offsets;
+    // Pairs (offset, size).
+    void operator()(TableView& v) const {
+        offsets->push_back(static_cast<size_t>(reinterpret_cast<unsigned char*>(&v) - base));
+        offsets->push_back(sizeof(TableView));
+    }
+    void operator()(TableOut& o) const {
+        offsets->push_back(static_cast<size_t>(reinterpret_cast<unsigned char*>(&o) - base));
+        offsets->push_back(sizeof(TableOut));
+    }
+};
+// The ids of the Tables a stage or evaluator names.
+struct CollectTableIds {
+    std::vector<uint64_t>* ids;
+    void operator()(TableView& v) const {
+        if (v.id) ids->push_back(v.id);
+    }
+    void operator()(TableOut& o) const {
+        if (o.id) ids->push_back(o.id);
     }
 };
 struct RepointStageTables {
@@ -211,11 +321,19 @@ class StageBinding {
         session_->Acquire(name, refs_, &device_);
         RepointStageTables repoint{&device_};
         stage_.VisitTables(repoint);
+        if (session_->emulated()) {
+            std::vector<size_t> named;
+            NamedTableOffsets offsets{reinterpret_cast<const unsigned char*>(&stage_), &named};
+            stage_.VisitTables(offsets);
+            session_->CheckNamedTables(name, reinterpret_cast<const unsigned char*>(&stage_),
+                                       sizeof(Stage), named);
+        }
     }
     const Stage& stage() const { return stage_; }
     void Finish() {
         session_->Produced(refs_);
-        if (own_) session_->DownloadOutputs(refs_);
+        if (own_ || IsTransientStage<Stage>::value) session_->DownloadOutputs(refs_);
+        if (IsTransientStage<Stage>::value) session_->ForgetViews(refs_);
     }
     // Bytes this run copied (uploads in the constructor, downloads in Finish).
     int64_t bytes_up() const { return session_->uploaded_bytes() - up0_; }
@@ -238,8 +356,34 @@ void RunStageDevice(const char* name, int64_t count, const Stage& stage);
 }  // namespace cuda
 #endif
 
+template <typename Evaluator>
+void ResidentScope::Keep(const Evaluator& evaluator) {
+    Evaluator copy = evaluator;
+    CollectTableIds collect{&keep_};
+    VisitEvaluatorTables(copy, collect);
+}
+
+// Calls body(i) for i in [0, count) in chunks of `grain`, advancing `progress`
+// (may be null) once per chunk.
+template <typename Body>
+void ParallelForWithProgress(int64_t count, int64_t grain, Progress* progress, const Body& body) {
+    if (!progress) {
+        ParallelFor(count, grain, [&](int64_t i) { body(i); });
+        return;
+    }
+    const int64_t chunks = (count + grain - 1) / grain;
+    ParallelFor(chunks, 1, [&](int64_t c) {
+        const int64_t end = c * grain + grain < count ? c * grain + grain : count;
+        for (int64_t i = c * grain; i < end; ++i) body(i);
+        progress->Add(end - c * grain);
+    });
+}
+
+// Runs stage(i) for i in [0, count) on the current backend (see the top of
+// this file); `progress` (may be null) is advanced by one per item.
 template <typename Stage>
-void RunStage(const char* name, int64_t count, int64_t grain, const Stage& stage) {
+void RunStage(const char* name, int64_t count, int64_t grain, const Stage& stage,
+              Progress* progress = nullptr) {
     static_assert(std::is_trivially_copyable<Stage>::value,
                   "stages are passed to kernels by value");
     if (count <= 0) return;
@@ -248,6 +392,7 @@ void RunStage(const char* name, int64_t count, int64_t grain, const Stage& stage
 #if defined(ATMOS_HAS_CUDA)
         if constexpr (HasDeviceStage<Stage>::value) {
             cuda::RunStageDevice(name, count, stage);
+            if (progress) progress->Add(count);
             return;
         } else {
             FailNoDeviceStage(name, true);
@@ -261,12 +406,12 @@ void RunStage(const char* name, int64_t count, int64_t grain, const Stage& stage
     if (backend == Backend::kEmulatedDevice) {
         StageBinding<Stage> binding(name, stage);
         const Stage& copy = binding.stage();
-        ParallelFor(count, grain, [&](int64_t i) { copy(i); });
+        ParallelForWithProgress(count, grain, progress, [&](int64_t i) { copy(i); });
         binding.Finish();
         up = binding.bytes_up();
         down = binding.bytes_down();
     } else {
-        ParallelFor(count, grain, [&](int64_t i) { stage(i); });
+        ParallelForWithProgress(count, grain, progress, [&](int64_t i) { stage(i); });
     }
     if (CurrentStageLog()) {
         const double ms =

@@ -1,0 +1,18 @@
+# Fails when a file under DIR (src/atmos/physics) includes a header of
+# src/atmos/render/ (run by ctest: layering_physics_below_render).
+file(GLOB_RECURSE files ${DIR}/*.h ${DIR}/*.cpp)
+if(NOT files)
+  message(FATAL_ERROR "no sources under ${DIR}")
+endif()
+set(bad "")
+foreach(f ${files})
+  file(STRINGS ${f} lines REGEX "^[ \t]*#[ \t]*include[ \t]*[\"<]render/")
+  if(lines)
+    list(APPEND bad "${f}: ${lines}")
+  endif()
+endforeach()
+if(bad)
+  string(REPLACE ";" "\n" bad "${bad}")
+  message(FATAL_ERROR "physics/ must not include render/:\n${bad}")
+endif()
+message(STATUS "physics/: no include of render/")
