@@ -177,10 +177,10 @@ def main():
     tmp = tempfile.mkdtemp()
     ref_pfm, test_pfm = os.path.join(tmp, "ref.pfm"), os.path.join(tmp, "test.pfm")
     size = "40x24"
-    subprocess.run([ATMOS, "render", "--model", "naive", "--view", "ground-sunrise", "--size",
-                    size, "--steps", "64", "-q", "-o", ref_pfm], check=True)
-    subprocess.run([ATMOS, "render", "--model", "naive", "--view", "ground-sunrise", "--size",
-                    size, "--steps", "4", "--light-steps", "2", "-q", "-o", test_pfm], check=True)
+    subprocess.run([ATMOS, "render", "--model", "naive:steps=64", "--view", "ground-sunrise",
+                    "--size", size, "-q", "-o", ref_pfm], check=True)
+    subprocess.run([ATMOS, "render", "--model", "naive:steps=4:light-steps=2", "--view",
+                    "ground-sunrise", "--size", size, "-q", "-o", test_pfm], check=True)
     ppd = 67.0206451
     for mode in ("ldr", "hdr"):
         map_pfm = os.path.join(tmp, "map.pfm")

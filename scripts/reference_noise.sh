@@ -17,7 +17,7 @@ for view in $views; do
         for spp in $spps; do
             for seed in 1 2; do
                 start=$(date +%s.%N)
-                "${ATMOS:-build/atmos}" render --model reference --estimator "$estimator" --spp "$spp" \
+                "${ATMOS:-build/atmos}" render --model "reference:estimator=$estimator" --spp "$spp" \
                     --seed "$seed" --view "$view" --size "$size" -q --checkpoint "$tmp/ckpt$seed" \
                     -o "$tmp/$seed.exr"
                 end=$(date +%s.%N)
