@@ -320,7 +320,6 @@ struct AtmospherePlusDirectEvaluator {
 
 class AtmospherePlusModel : public EvaluatorModel<AtmospherePlusModel> {
   public:
-    using Options = AplusSettings;
     static const OptionTable<AplusSettings>& OptionRows();
     explicit AtmospherePlusModel(const AplusSettings& options);
     static ModelInfo StaticInfo();

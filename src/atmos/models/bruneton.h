@@ -518,7 +518,6 @@ BrunetonLut MakeBrunetonLut(const AtmosphereParameters& atmosphere, const Brunet
 
 class BrunetonModel : public EvaluatorModel<BrunetonModel> {
   public:
-    using Options = BrunetonConfig;
     static const OptionTable<BrunetonConfig>& OptionRows();
     explicit BrunetonModel(const BrunetonConfig& options);
     static ModelInfo StaticInfo();

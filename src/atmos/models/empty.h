@@ -22,7 +22,6 @@ struct EmptyEvaluator {
 
 class EmptyModel : public SimpleEvaluatorModel<EmptyModel, EmptyEvaluator> {
   public:
-    using Options = NoOptions;
     static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit EmptyModel(const NoOptions&) {}
     static ModelInfo StaticInfo();

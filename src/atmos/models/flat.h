@@ -124,7 +124,6 @@ struct FlatEvaluator {
 
 class FlatModel : public SimpleEvaluatorModel<FlatModel, FlatEvaluator> {
   public:
-    using Options = NoOptions;
     static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit FlatModel(const NoOptions& options);
     static ModelInfo StaticInfo();

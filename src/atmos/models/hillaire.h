@@ -441,7 +441,6 @@ struct HillaireOptions {
 
 class HillaireModel : public Model {
   public:
-    using Options = HillaireOptions;
     static const OptionTable<HillaireOptions>& OptionRows();
     explicit HillaireModel(const HillaireOptions& options);
     static ModelInfo StaticInfo();

@@ -81,7 +81,6 @@ struct NaiveOptions {
 
 class NaiveModel : public SimpleEvaluatorModel<NaiveModel, NaiveEvaluator> {
   public:
-    using Options = NaiveOptions;
     static const OptionTable<NaiveOptions>& OptionRows();
     explicit NaiveModel(const NaiveOptions& options);
     static ModelInfo StaticInfo();

@@ -154,7 +154,6 @@ struct NeuralOptions {
 
 class NeuralModel : public SimpleEvaluatorModel<NeuralModel, NeuralEvaluator> {
   public:
-    using Options = NeuralOptions;
     static const OptionTable<NeuralOptions>& OptionRows();
     explicit NeuralModel(const NeuralOptions& options);
     static ModelInfo StaticInfo();

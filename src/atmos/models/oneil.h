@@ -150,7 +150,6 @@ struct OneilOptions {
 
 class OneilModel : public SimpleEvaluatorModel<OneilModel, OneilEvaluator> {
   public:
-    using Options = OneilOptions;
     static const OptionTable<OneilOptions>& OptionRows();
     explicit OneilModel(const OneilOptions& options);
     static ModelInfo StaticInfo();

@@ -152,7 +152,6 @@ struct PreethamOptions {
 
 class PreethamModel : public SimpleEvaluatorModel<PreethamModel, PreethamEvaluator> {
   public:
-    using Options = PreethamOptions;
     static const OptionTable<PreethamOptions>& OptionRows();
     explicit PreethamModel(const PreethamOptions& options);
     static ModelInfo StaticInfo();

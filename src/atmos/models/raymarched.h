@@ -73,7 +73,6 @@ struct RaymarchedOptions {
 
 class RaymarchedModel : public SimpleEvaluatorModel<RaymarchedModel, RaymarchedEvaluator> {
   public:
-    using Options = RaymarchedOptions;
     static const OptionTable<RaymarchedOptions>& OptionRows();
     explicit RaymarchedModel(const RaymarchedOptions& options);
     static ModelInfo StaticInfo();

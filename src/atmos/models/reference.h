@@ -475,7 +475,6 @@ struct ReferenceOptions {
 // the passes, checkpoints and variance are the progressive driver's.
 class ReferenceModel : public MonteCarloModel {
   public:
-    using Options = ReferenceOptions;
     static const OptionTable<ReferenceOptions>& OptionRows();
     explicit ReferenceModel(const ReferenceOptions& options);
     static ModelInfo StaticInfo();

@@ -14,10 +14,9 @@ namespace atmos {
 
 namespace {
 
-// Each model M provides `static ModelInfo StaticInfo()`, its options struct
-// (`M::Options`), `static const OptionTable<M::Options>& OptionRows()` and a
-// constructor from M::Options: the registry parses and validates the user's
-// option text through the table, once, and hands the model its typed struct.
+// Each model M provides `static ModelInfo StaticInfo()`, an options struct O,
+// `static const OptionTable<O>& OptionRows()` and a constructor from O: the registry parses and
+// validates the user's option text through the table, once, and hands the model its typed struct.
 struct Entry {
     std::function<ModelInfo()> info;
     std::function<std::unique_ptr<Model>(const std::string&,

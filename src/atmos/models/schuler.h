@@ -73,7 +73,6 @@ struct SchulerOptions {
 
 class SchulerModel : public SimpleEvaluatorModel<SchulerModel, SchulerEvaluator> {
   public:
-    using Options = SchulerOptions;
     static const OptionTable<SchulerOptions>& OptionRows();
     explicit SchulerModel(const SchulerOptions& options);
     static ModelInfo StaticInfo();

@@ -46,7 +46,6 @@ struct TransmittanceChapmanOptions {
 class TransmittanceChapmanModel
     : public TransmittanceModel<TransmittanceChapmanModel, ChapmanTransmittanceOptics> {
   public:
-    using Options = TransmittanceChapmanOptions;
     static const OptionTable<TransmittanceChapmanOptions>& OptionRows();
     explicit TransmittanceChapmanModel(const TransmittanceChapmanOptions& options);
     static ModelInfo StaticInfo();

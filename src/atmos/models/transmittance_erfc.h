@@ -33,7 +33,6 @@ struct ErfcTransmittanceOptics {
 class TransmittanceErfcModel
     : public TransmittanceModel<TransmittanceErfcModel, ErfcTransmittanceOptics> {
   public:
-    using Options = NoOptions;
     static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit TransmittanceErfcModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
     static ModelInfo StaticInfo();

@@ -19,7 +19,6 @@ namespace atmos {
 
 class TransmittanceFlatModel : public TransmittanceModel<TransmittanceFlatModel, FlatOptics> {
   public:
-    using Options = NoOptions;
     static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit TransmittanceFlatModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
     static ModelInfo StaticInfo();

@@ -18,7 +18,6 @@ struct TransmittanceOneilOptions {
 
 class TransmittanceOneilModel : public TransmittanceModel<TransmittanceOneilModel, OneilOptics> {
   public:
-    using Options = TransmittanceOneilOptions;
     static const OptionTable<TransmittanceOneilOptions>& OptionRows();
     explicit TransmittanceOneilModel(const TransmittanceOneilOptions& options);
     static ModelInfo StaticInfo();

@@ -69,7 +69,6 @@ PolynomialSigmoid FitPolynomialSigmoid(const AtmosphereParameters& atmosphere,
 class TransmittancePolynomialModel
     : public TransmittanceModel<TransmittancePolynomialModel, PolynomialTransmittanceOptics> {
   public:
-    using Options = NoOptions;
     static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit TransmittancePolynomialModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
     static ModelInfo StaticInfo();

@@ -38,7 +38,6 @@ struct TransmittanceReferenceOptions {
 class TransmittanceReferenceModel
     : public TransmittanceModel<TransmittanceReferenceModel, ReferenceTransmittanceOptics> {
   public:
-    using Options = TransmittanceReferenceOptions;
     static const OptionTable<TransmittanceReferenceOptions>& OptionRows();
     explicit TransmittanceReferenceModel(const TransmittanceReferenceOptions& options);
     static ModelInfo StaticInfo();
