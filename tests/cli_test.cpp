@@ -159,6 +159,14 @@ TEST(Cli, ErrorPaths) {
     // The old syntax (a model option as a flag) says where options go now.
     ExpectError("render --model naive --steps 3" + o, "--model naive:steps=VALUE");
     ExpectError("render --bogus-flag" + o, "bogus");
+    // FLIP's pixels per degree: 1e12 overflowed the filter radius (SIGSEGV), 1e9 hung.
+    for (const char* ppd : {"1e12", "1e9", "-1", "nan"}) {
+        ExpectError(std::string("flip a.exr b.exr --ppd ") + ppd, "--ppd must be in (0, 10000]");
+        ExpectError(
+            std::string("compare --models empty --views space --size 8x4 --no-cache --ppd ") + ppd +
+                " -o " + (TempDir() / "ppd").string(),
+            "--ppd must be in (0, 10000]");
+    }
     ExpectError("frobnicate", "frobnicate");
     ExpectError("bake --model naive -o " + (TempDir() / "bake").string(), "no precomputed tables");
     ExpectError("bake --model naive", "--output");

@@ -70,6 +70,7 @@ int CmdCompare(const CompareCliOptions& o) {
     config.cache_dir = o.no_cache ? "" : o.backend == "cuda" ? o.cache + "/cuda" : o.cache;
     config.write_npy = !o.no_npy;
     config.show_progress = !o.quiet;
+    CheckFlipPpd(o.ppd);
     config.flip.ppd = o.ppd;
     config.flip.tone_mapper = ParseFlipToneMapper(o.tone_mapper);
     config.command_line = o.command_line;

@@ -23,7 +23,7 @@ struct FlipCliOptions {
 };
 
 int CmdFlip(const FlipCliOptions& o) {
-    if (!(o.ppd >= 0.0) || !std::isfinite(o.ppd)) Fail("--ppd must be a positive number");
+    CheckFlipPpd(o.ppd);
     FlipOptions options;
     options.ppd = o.ppd;
     options.tone_mapper = ParseFlipToneMapper(o.tone_mapper);

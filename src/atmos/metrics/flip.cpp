@@ -207,7 +207,10 @@ void CheckPair(const Image& a, const Image& b) {
     }
 }
 
-double Ppd(const FlipOptions& o) { return o.ppd > 0.0 ? o.ppd : FlipDefaultPpd(); }
+double Ppd(const FlipOptions& o) {
+    CheckFlipPpd(o.ppd);
+    return o.ppd > 0.0 ? o.ppd : FlipDefaultPpd();
+}
 
 // Spec 2: the LDR-FLIP map of two linear RGB images (clamped here).
 std::vector<float> LdrFlipMap(const Image& ref, const Image& test, double ppd) {
@@ -292,6 +295,13 @@ const char* FlipToneMapperName(FlipToneMapper t) {
 
 double FlipPixelsPerDegree(double distance_m, double monitor_width_m, double resolution_px) {
     return distance_m * (resolution_px / monitor_width_m) * (static_cast<double>(kFlipPi) / 180.0);
+}
+
+void CheckFlipPpd(double ppd) {
+    if (!(ppd >= 0.0 && ppd <= kFlipMaxPpd)) {
+        Fail("--ppd must be in (0, ", kFlipMaxPpd, "] pixels per degree (0 or absent: the default ",
+             FlipDefaultPpd(), "), got ", ppd);
+    }
 }
 
 double FlipDefaultPpd() {

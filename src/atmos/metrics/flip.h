@@ -33,6 +33,12 @@ const char* FlipToneMapperName(FlipToneMapper t);
 double FlipPixelsPerDegree(double distance_m, double monitor_width_m, double resolution_px);
 // The default viewing condition (0.7 m, 0.7 m, 3840 px): 67.0206451.
 double FlipDefaultPpd();
+// The largest pixels per degree accepted: the filters' radius grows with ppd
+// (about 0.2 ppd pixels), so a larger value only costs time (and overflowed the
+// radius at 1e12).
+constexpr double kFlipMaxPpd = 1e4;
+// Throws atmos::Error unless ppd is 0 (the default) or in (0, kFlipMaxPpd].
+void CheckFlipPpd(double ppd);
 
 struct FlipOptions {
     double ppd = 0.0;  // <= 0: FlipDefaultPpd()
