@@ -50,8 +50,8 @@ void RunSample(benchmark::State& state, const char* name) {
 void BM_ModelSampleNaive(benchmark::State& state) { RunSample(state, "naive"); }
 BENCHMARK(BM_ModelSampleNaive)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-void BM_ModelSampleHillaire(benchmark::State& state) { RunSample(state, "hillaire"); }
-BENCHMARK(BM_ModelSampleHillaire)->Unit(benchmark::kMillisecond)->UseRealTime();
+void BM_ModelSampleBruneton(benchmark::State& state) { RunSample(state, "bruneton"); }
+BENCHMARK(BM_ModelSampleBruneton)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace atmos

@@ -17,7 +17,7 @@ import atmos
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--models", nargs="*", default=["naive", "hillaire"])
+    ap.add_argument("--models", nargs="*", default=["naive", "bruneton"])
     ap.add_argument("--repetitions", type=int, default=5)
     ap.add_argument("--threads", type=int, default=2)
     args = ap.parse_args()
