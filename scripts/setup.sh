@@ -17,9 +17,12 @@ if [ -z "$build_dir" ]; then
 fi
 
 # chromium + a font: the report test loads out/index.html in headless Chromium.
+# python3-*, pybind11-dev: the Python module (import atmos, python/) and its
+# pytest suite, built for Debian's /usr/bin/python3; matplotlib: examples/.
 packages=(cmake g++ make ninja-build pkg-config libopenexr-dev libpng-dev nlohmann-json3-dev
           libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev clang-format
-          chromium fonts-dejavu-core)
+          chromium fonts-dejavu-core
+          python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Set up, build and run the test suite (GoogleTest through ctest).
-# Usage: scripts/test.sh [--sanitize]   (--sanitize: ASan + UBSan build in build-asan/)
+# Set up, build and run the test suite (GoogleTest and the Python module's
+# pytest suite, python/tests, through ctest).
+# Usage: scripts/test.sh [--sanitize]   (--sanitize: ASan + UBSan build in build-asan/,
+# without the Python module: an instrumented extension cannot load into python3)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir=build

@@ -11,6 +11,8 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "atmos/atmosphere.h"
 #include "atmos/error.h"
@@ -130,6 +132,24 @@ TEST(Progressive, PassesOfAnyMonteCarloModelWeightedByTheirCounts) {
     EXPECT_EQ(PassSpp(CoinRequest(5, 0).monte_carlo), 1);
     EXPECT_EQ(PassSpp(CoinRequest(4096, 0).monte_carlo), 64);
     EXPECT_EQ(PassSpp(CoinRequest(4096, 3).monte_carlo), 3);
+}
+
+TEST(Progressive, OnPassIsCalledAfterEveryPassAndCanStopTheRender) {
+    const CoinModel model(true);
+    RenderRequest request = CoinRequest(10, 4);  // 3 passes
+    std::vector<std::pair<int64_t, int64_t>> calls;
+    request.on_pass = [&](int64_t done, int64_t total) { calls.emplace_back(done, total); };
+    Image image;
+    model.Render(request, &image);
+    const std::vector<std::pair<int64_t, int64_t>> expected = {{1, 3}, {2, 3}, {3, 3}};
+    EXPECT_EQ(calls, expected);
+    // A throwing callback stops after that pass; the error reaches the caller.
+    request.on_pass = [](int64_t done, int64_t) {
+        if (done == 2) throw Error("stop");
+    };
+    model.passes_rendered = 0;
+    EXPECT_THROW(model.Render(request, &image), Error);
+    EXPECT_EQ(model.passes_rendered, 2);
 }
 
 TEST(Progressive, ResumesACheckpointOfAnyMonteCarloModel) {

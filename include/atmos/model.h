@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -109,6 +110,10 @@ struct RenderRequest {
     std::string checkpoint;
     bool resume = false;
     Image* variance = nullptr;
+    // Called on the calling thread after each pass of a Monte Carlo model
+    // (passes done, passes in all, counting resumed ones); may throw to stop
+    // the render (the checkpoint keeps the passes done). Others ignore it.
+    std::function<void(int64_t, int64_t)> on_pass;
 };
 
 class Model {

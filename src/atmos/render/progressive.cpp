@@ -249,6 +249,7 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
         pass.samples = mc.spp;
         model.RenderPass(request, pass, out, &progress);
         if (request.variance) request.variance->Resize(request.width, request.height);
+        if (request.on_pass) request.on_pass(1, 1);
         return;
     }
     // Passes of pass_spp samples (auto: 8 passes, so the variance of the mean
@@ -307,6 +308,14 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
         if (std::chrono::duration<double>(now - last_save).count() > 10.0 || p + 1 == passes) {
             save_checkpoint();
             last_save = now;
+        }
+        if (request.on_pass) {
+            try {
+                request.on_pass(passes_done, passes);
+            } catch (...) {
+                save_checkpoint();  // keep the passes done
+                throw;
+            }
         }
     }
     // Mean, and the variance of the mean from the pass means (batch means):
