@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
         AddRenderCommand(&app),
         AddSampleCommand(&app),
         AddBakeCommand(&app),
+        AddViewerCommand(&app),
         AddFlipCommand(&app),
         AddRmseCommand(&app),
         AddCompareCommand(&app, argc, argv),

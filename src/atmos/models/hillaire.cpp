@@ -13,6 +13,7 @@
 
 #include "atmos/error.h"
 #include "base/parallel.h"
+#include "io/raw_tables.h"
 #include "io/table_io.h"
 #include "models/hillaire_stages.h"
 #include "models/option_json.h"
@@ -288,6 +289,10 @@ void HillaireModel::Bake(const std::string& directory) const {
            "x = 0.5 mu_s + 0.5, y = (r - bottom) / (top - bottom); u = 0.5/32 + x (1 - 1/32), "
            "v likewise"}}});
     j["atmosphere"] = nlohmann::json::parse(AtmosphereToJson(evaluator_.atm));
+    j["raw"] = nlohmann::json::parse(
+        WriteRawTables(directory, {{"transmittance", &transmittance_},
+                                   {"multiple_scattering", &multiple_scattering_}})
+            .dump());
     std::ofstream f(fs::path(directory) / kBakeJson);
     f << j.dump(2) << "\n";
     if (!f) Fail("cannot write ", (fs::path(directory) / kBakeJson).string());
