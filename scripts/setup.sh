@@ -17,6 +17,7 @@ if [ -z "$build_dir" ]; then
 fi
 
 # chromium + a font: the report test loads out/index.html in headless Chromium.
+# (The viewer test also renders `atmos viewer`'s page there: WebGL2 on SwiftShader.)
 packages=(cmake g++ make ninja-build pkg-config libopenexr-dev libpng-dev nlohmann-json3-dev
           libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev clang-format
           chromium fonts-dejavu-core)
