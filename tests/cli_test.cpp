@@ -207,6 +207,9 @@ TEST(Cli, ErrorPaths) {
                     (TempDir() / "viewer").string(),
                 "one model");
     ExpectError("viewer --models bruneton", "--output");
+    ExpectError("viewer --model naive -o " + (TempDir() / "viewer").string(), "has no shaders");
+    ExpectError("viewer --model bruneton --models bruneton -o " + (TempDir() / "viewer").string(),
+                "not both");
     ExpectError("render --model naive --load /nonexistent" + o, "no precomputed tables to load");
     ExpectError("sample --model naive", "header", "");
     ExpectError("sample --model naive", "header", "a,b,c\n");

@@ -174,8 +174,13 @@ Command AddViewerCommand(CLI::App* root) {
                      "models to bake, NAME[:OPTION=VALUE...] comma-separated (default: "
                      "bruneton); with --load DIR, one model read from DIR")
         ->delimiter(',');
-    c.run = [common, output, models] {
+    CLI::Option* model_flag = c.app->get_option("--model");
+    c.run = [common, output, models, model_flag] {
         std::vector<std::string> specs = *models;
+        if (model_flag->count() > 0) {
+            if (!specs.empty()) Fail("give --models or --model, not both");
+            specs.push_back(common->model);  // --model: one model, as for bake
+        }
         if (specs.empty()) specs.push_back("bruneton");
         if (!common->load.empty() && specs.size() != 1) {
             Fail("--load reads one model's tables: give one model in --models");
