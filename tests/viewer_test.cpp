@@ -90,7 +90,7 @@ std::string Attribute(const std::string& html, size_t tag, const std::string& na
 }
 
 struct BrowserImage {
-    std::string view;
+    std::string model, view;
     double ms = 0.0;
     atmos::Image image;
 };
@@ -114,14 +114,19 @@ TEST(Viewer, WebGlRenderingOfTheBakedTablesMatchesAtmosRender) {
     // sizes: bruneton_constants.glsl); combined Mie storage exercises the
     // shader's extrapolated-Mie path (the default, separate, is in the README's
     // measurements, docs/engine.md).
-    const std::string model =
+    const std::string bruneton =
         "bruneton:orders=2:scattering-r=16:scattering-mu=64:scattering-mu-s=16:mie-storage="
         "combined";
-    ASSERT_EQ(System(cli + " viewer --models " + model + " -o " + page.string() + " --quiet > " +
-                     (dir / "viewer.log").string() + " 2>&1"),
+    // Hillaire: its baked tables, and per view the sky-view and aerial-
+    // perspective passes of shaders/hillaire.glsl.
+    const std::map<std::string, std::string> models = {{"bruneton", bruneton},
+                                                       {"hillaire", "hillaire"}};
+    ASSERT_EQ(System(cli + " viewer --models " + bruneton + ",hillaire -o " + page.string() +
+                     " --quiet > " + (dir / "viewer.log").string() + " 2>&1"),
               0)
         << Slurp(dir / "viewer.log");
     ASSERT_TRUE(fs::exists(page / "bruneton" / "shaders" / "bruneton.glsl"));
+    ASSERT_TRUE(fs::exists(page / "hillaire" / "shaders" / "hillaire.glsl"));
 
     const int width = 320, height = 180;
     const fs::path dom = dir / "dom.html";
@@ -155,6 +160,7 @@ TEST(Viewer, WebGlRenderingOfTheBakedTablesMatchesAtmosRender) {
     for (size_t at = html.find("<pre class=\"atmos-image\""); at != std::string::npos;
          at = html.find("<pre class=\"atmos-image\"", at + 1)) {
         BrowserImage b;
+        b.model = Attribute(html, at, "data-model");
         b.view = Attribute(html, at, "data-view");
         b.ms = std::atof(Attribute(html, at, "data-ms").c_str());
         ASSERT_EQ(Attribute(html, at, "data-width"), std::to_string(width));
@@ -166,24 +172,27 @@ TEST(Viewer, WebGlRenderingOfTheBakedTablesMatchesAtmosRender) {
         std::memcpy(b.image.data(), bytes.data(), bytes.size());
         images.push_back(std::move(b));
     }
-    ASSERT_EQ(images.size(), 12u);
+    ASSERT_EQ(images.size(), 24u);
 
     // The library from the same tables.
     const fs::path renders = dir / "render";
-    ASSERT_EQ(
-        System(cli + " render --model " + model + " --load " + (page / "bruneton").string() +
-               " --view all --size " + std::to_string(width) + "x" + std::to_string(height) +
-               " --quiet -o " + renders.string() + " > " + (dir / "render.log").string() + " 2>&1"),
-        0)
-        << Slurp(dir / "render.log");
+    for (const auto& [name, spec] : models) {
+        ASSERT_EQ(System(cli + " render --model " + spec + " --load " + (page / name).string() +
+                         " --view all --size " + std::to_string(width) + "x" +
+                         std::to_string(height) + " --quiet -o " + renders.string() + " > " +
+                         (dir / "render.log").string() + " 2>&1"),
+                  0)
+            << Slurp(dir / "render.log");
+    }
     for (const BrowserImage& b : images) {
+        ASSERT_EQ(models.count(b.model), 1u) << b.model;
+        // `render --view all` names files MODEL-VIEW with MODEL as given.
         const atmos::Image reference =
-            // `render --view all` names files MODEL-VIEW with MODEL as given.
-            atmos::ReadImage((renders / (model + "-" + b.view + ".exr")).string());
+            atmos::ReadImage((renders / (models.at(b.model) + "-" + b.view + ".exr")).string());
         const atmos::FlipResult flip = atmos::HdrFlip(reference, b.image);
-        std::printf("bruneton %-22s HDR-FLIP %.5f  (browser %.0f ms)\n", b.view.c_str(), flip.mean,
-                    b.ms);
-        EXPECT_LE(flip.mean, 0.01) << b.view;
+        std::printf("%-9s %-22s HDR-FLIP %.5f  (browser %.0f ms)\n", b.model.c_str(),
+                    b.view.c_str(), flip.mean, b.ms);
+        EXPECT_LE(flip.mean, 0.01) << b.model << " " << b.view;
     }
     fs::remove_all(dir);
 }

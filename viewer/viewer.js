@@ -183,7 +183,9 @@ function makeModel(gl, name, format) {
     bruneton: [['atmos_transmittance_texture', 'transmittance'],
                ['atmos_irradiance_texture', 'irradiance'],
                ['atmos_scattering_texture', 'scattering'],
-               ['atmos_single_mie_texture', 'single_mie_scattering']]}[name];
+               ['atmos_single_mie_texture', 'single_mie_scattering']],
+    hillaire: [['atmos_transmittance_texture', 'transmittance'],
+               ['atmos_multiple_scattering_texture', 'multiple_scattering']]}[name];
   var textures = [];
   gl.useProgram(program);
   samplers.forEach(function (s) {
@@ -193,8 +195,134 @@ function makeModel(gl, name, format) {
     textures.push(t);
   });
   var atm = data.bake.atmosphere;
-  return {name: name, program: program, textures: textures,
-          bottom: atm.bottom_radius, top: atm.top_radius};
+  var model = {name: name, program: program, textures: textures,
+               bottom: atm.bottom_radius, top: atm.top_radius};
+  if (name === 'hillaire') makeHillaireFrame(gl, model, fragment.replace(MAIN_SHADER, ''));
+  return model;
+}
+
+// Hillaire's per-frame tables (hillaire.glsl, passes 1 and 2): the sky-view
+// table (192 x 108) and the aerial-perspective volume (32^3, in-scatter and
+// transmittance), float render targets sampled by the main pass.
+var SKY_VIEW_MAIN = [
+  'uniform float u_r;',
+  'uniform vec3 u_sun;',
+  'out vec4 frag_color;',
+  'void main() {',
+  '  frag_color = vec4(atmos_SkyViewTexel(ivec2(gl_FragCoord.xy), u_r, u_sun), 1.0);',
+  '}'].join('\n');
+var AP_MAIN = [
+  'uniform int u_slice;',
+  'uniform vec3 u_camera;',
+  'uniform vec3 u_sun;',
+  'layout(location = 0) out vec4 frag_scatter;',
+  'layout(location = 1) out vec4 frag_transmittance;',
+  'void main() {',
+  '  vec3 L, T;',
+  '  atmos_AerialPerspectiveTexel(ivec3(ivec2(gl_FragCoord.xy), u_slice), u_camera, u_sun, L, T);',
+  '  frag_scatter = vec4(L, 1.0);',
+  '  frag_transmittance = vec4(T, 1.0);',
+  '}'].join('\n');
+
+function linkProgram(gl, fragment) {
+  var program = gl.createProgram();
+  gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, VERTEX_SHADER));
+  gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, fragment));
+  gl.linkProgram(program);
+  if (!gl.getProgramParameter(program, gl.LINK_STATUS)) {
+    throw new Error('link error: ' + gl.getProgramInfoLog(program));
+  }
+  return program;
+}
+
+function makeTarget(gl, target, w, h, d) {
+  var internal = gl.getExtension('OES_texture_float_linear') ? gl.RGBA32F : gl.RGBA16F;
+  var tex = gl.createTexture();
+  gl.bindTexture(target, tex);
+  if (target === gl.TEXTURE_3D) {
+    gl.texStorage3D(target, 1, internal, w, h, d);
+    gl.texParameteri(target, gl.TEXTURE_WRAP_R, gl.CLAMP_TO_EDGE);
+  } else {
+    gl.texStorage2D(target, 1, internal, w, h);
+  }
+  gl.texParameteri(target, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
+  gl.texParameteri(target, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
+  gl.texParameteri(target, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
+  gl.texParameteri(target, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+  return {texture: tex, target: target};
+}
+
+function makeHillaireFrame(gl, model, base) {
+  if (!gl.getExtension('EXT_color_buffer_float')) {
+    throw new Error('hillaire needs EXT_color_buffer_float (float render targets)');
+  }
+  var sky = makeTarget(gl, gl.TEXTURE_2D, 192, 108, 1);
+  var apS = makeTarget(gl, gl.TEXTURE_3D, 32, 32, 32);
+  var apT = makeTarget(gl, gl.TEXTURE_3D, 32, 32, 32);
+  var units = [['atmos_sky_view_texture', sky], ['atmos_ap_scatter_texture', apS],
+               ['atmos_ap_transmittance_texture', apT]];
+  gl.useProgram(model.program);
+  units.forEach(function (u) {
+    gl.uniform1i(gl.getUniformLocation(model.program, u[0]), model.textures.length);
+    model.textures.push(u[1]);
+  });
+  var passes = {sky: linkProgram(gl, base + SKY_VIEW_MAIN), ap: linkProgram(gl, base + AP_MAIN),
+                skyTarget: sky, apScatter: apS, apTransmittance: apT,
+                skyFb: gl.createFramebuffer(), apFb: gl.createFramebuffer()};
+  [passes.sky, passes.ap].forEach(function (p) {
+    gl.useProgram(p);
+    gl.uniform1i(gl.getUniformLocation(p, 'atmos_transmittance_texture'), 0);
+    gl.uniform1i(gl.getUniformLocation(p, 'atmos_multiple_scattering_texture'), 1);
+  });
+  gl.bindFramebuffer(gl.FRAMEBUFFER, passes.skyFb);
+  gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, sky.texture, 0);
+  model.hillaire = passes;
+}
+
+// The frame camera of Hillaire's aerial-perspective volume (atmos_ap_*).
+function setApCamera(gl, program, c, aspect) {
+  gl.uniform3fv(gl.getUniformLocation(program, 'atmos_ap_forward'), c.forward);
+  gl.uniform3fv(gl.getUniformLocation(program, 'atmos_ap_right'), c.right);
+  gl.uniform3fv(gl.getUniformLocation(program, 'atmos_ap_up'), c.up);
+  gl.uniform1f(gl.getUniformLocation(program, 'atmos_ap_tan_half_fov_y'), c.tanHalfFovY);
+  gl.uniform1f(gl.getUniformLocation(program, 'atmos_ap_aspect'), aspect);
+}
+
+// HillaireModel::BuildFrame: for a camera inside the atmosphere, the sky-view
+// table for its radius and sun, and the aerial-perspective volume for its frustum.
+function buildHillaireFrame(gl, model, view, aspect) {
+  var h = model.hillaire;
+  var pos = view.camera.position;
+  var r = Math.sqrt(vDot(pos, pos));
+  if (!(r <= model.top)) return;
+  var sun = vNormalize(view.sun);
+  var mu_s = Math.max(-1, Math.min(1, vDot(sun, pos) / r));
+  gl.disable(gl.SCISSOR_TEST);
+  gl.activeTexture(gl.TEXTURE0);
+  gl.bindTexture(gl.TEXTURE_2D, model.textures[0].texture);
+  gl.activeTexture(gl.TEXTURE1);
+  gl.bindTexture(gl.TEXTURE_2D, model.textures[1].texture);
+  gl.useProgram(h.sky);
+  gl.uniform1f(gl.getUniformLocation(h.sky, 'u_r'), Math.max(r, model.bottom + 1.0));
+  gl.uniform3fv(gl.getUniformLocation(h.sky, 'u_sun'),
+                [Math.sqrt(Math.max(0, 1 - mu_s * mu_s)), 0, mu_s]);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, h.skyFb);
+  gl.viewport(0, 0, 192, 108);
+  gl.drawArrays(gl.TRIANGLES, 0, 3);
+  gl.useProgram(h.ap);
+  setApCamera(gl, h.ap, view.camera, aspect);
+  gl.uniform3fv(gl.getUniformLocation(h.ap, 'u_camera'), pos);
+  gl.uniform3fv(gl.getUniformLocation(h.ap, 'u_sun'), sun);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, h.apFb);
+  gl.drawBuffers([gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1]);
+  gl.viewport(0, 0, 32, 32);
+  for (var k = 0; k < 32; ++k) {
+    gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, h.apScatter.texture, 0, k);
+    gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, h.apTransmittance.texture,
+                               0, k);
+    gl.uniform1i(gl.getUniformLocation(h.ap, 'u_slice'), k);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+  }
 }
 
 function bindModel(gl, model) {
@@ -207,9 +335,12 @@ function bindModel(gl, model) {
 
 // Draws `view` with `model` into the bound framebuffer, pixels [x0, x1) of a
 // width x height image.
-function drawView(gl, model, view, width, height, opts, x0, x1) {
+function drawView(gl, model, view, width, height, opts, x0, x1, target) {
+  if (model.hillaire) buildHillaireFrame(gl, model, view, width / height);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, target);
   bindModel(gl, model);
   var p = model.program;
+  if (model.hillaire) setApCamera(gl, p, view.camera, width / height);
   function u(name) { return gl.getUniformLocation(p, name); }
   var c = view.camera;
   gl.uniform3fv(u('u_camera'), c.position);
@@ -250,7 +381,7 @@ function runTests(gl, format) {
     standardViews(model.bottom, model.top).forEach(function (view) {
       var t0 = performance.now();
       drawView(gl, model, view, width, height, {raw: true, sunDisc: false, exposure: 1}, 0,
-               width);
+               width, fb);
       gl.readPixels(0, 0, width, height, gl.RGBA, gl.FLOAT, pixels);
       var ms = performance.now() - t0;
       // Rows top-down, as the images of `atmos render`.
@@ -375,10 +506,10 @@ function runViewer(gl, canvas, format) {
     var t0 = performance.now();
     var a = models[el('model').value], b = models[el('model2').value];
     if (el('split').checked) {
-      drawView(gl, a, view, W, H, opts, 0, W >> 1);
-      drawView(gl, b, view, W, H, opts, W >> 1, W);
+      drawView(gl, a, view, W, H, opts, 0, W >> 1, null);
+      drawView(gl, b, view, W, H, opts, W >> 1, W, null);
     } else {
-      drawView(gl, a, view, W, H, opts, 0, W);
+      drawView(gl, a, view, W, H, opts, 0, W, null);
     }
     gl.finish();
     var draw = performance.now() - t0;
@@ -405,6 +536,7 @@ function runViewer(gl, canvas, format) {
     viewSelect.dispatchEvent(new Event('change'));
   }
   if (atmosViewerParams.get('split')) el('split').checked = true;
+  if (atmosViewerModels.length > 1) el('model2').value = atmosViewerModels[1];
   document.getElementById('atmos-test').setAttribute('data-status', 'viewer');
   window.requestAnimationFrame(frame);
 }
