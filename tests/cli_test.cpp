@@ -202,7 +202,8 @@ TEST(Cli, ErrorPaths) {
     ExpectError("frobnicate", "frobnicate");
     ExpectError("bake --model naive -o " + (TempDir() / "bake").string(), "no precomputed tables");
     ExpectError("bake --model naive", "--output");
-    ExpectError("viewer --models hillaire -o " + (TempDir() / "viewer").string(), "has no shaders");
+    ExpectError("viewer --models atmosphere-plus -o " + (TempDir() / "viewer").string(),
+                "has no shaders");
     ExpectError("viewer --models bruneton,bruneton --load /nonexistent -o " +
                     (TempDir() / "viewer").string(),
                 "one model");

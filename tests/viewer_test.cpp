@@ -1,7 +1,7 @@
 // The engine path equals the library (issue 20): `atmos viewer` bakes
-// bruneton and writes the WebGL2 page; headless Chromium (Debian's
-// `chromium`, WebGL2 on SwiftShader) renders the 12 views from the baked
-// float32 tables with shaders/bruneton.glsl into a float framebuffer, the page
+// bruneton and hillaire and writes the WebGL2 page; headless Chromium (Debian's
+// `chromium`, WebGL2 on SwiftShader) renders the 12 views of each from the baked
+// float32 tables with shaders/NAME.glsl into a float framebuffer, the page
 // puts the pixels in the DOM (read back with --dump-dom), and each must match
 // `atmos render --load` of the same view from the same tables: mean HDR-FLIP
 // <= 0.01. Skipped, with one line, where Chromium cannot start or has no WebGL2.

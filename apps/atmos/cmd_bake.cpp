@@ -181,7 +181,7 @@ Command AddViewerCommand(CLI::App* root) {
             if (!specs.empty()) Fail("give --models or --model, not both");
             specs.push_back(common->model);  // --model: one model, as for bake
         }
-        if (specs.empty()) specs.push_back("bruneton");
+        if (specs.empty()) specs = {"bruneton", "hillaire"};
         if (!common->load.empty() && specs.size() != 1) {
             Fail("--load reads one model's tables: give one model in --models");
         }
@@ -194,7 +194,7 @@ Command AddViewerCommand(CLI::App* root) {
             const std::string name = ParseModelSpec(spec).name;
             if (!FindAsset(ShaderAsset(name))) {
                 Fail("model ", name, " has no shaders (", ShaderAsset(name),
-                     "): the viewer shows bruneton");
+                     "): the viewer shows bruneton and hillaire");
             }
             BakeInto(one, (dir / name).string());
             WriteViewerData(dir / name, name);
