@@ -1,5 +1,5 @@
 # Thin wrappers over scripts/ (the README's commands).
-.PHONY: setup run test test-asan bench format
+.PHONY: setup run test test-asan bench format viewer
 setup:
 	scripts/setup.sh
 run:
@@ -10,5 +10,7 @@ test-asan:
 	scripts/test.sh --sanitize
 bench: setup
 	build/bench/atmos_bench
+viewer: setup
+	build/atmos viewer -o out/viewer
 format:
 	clang-format -i $$(git ls-files '*.h' '*.cpp' '*.cu')

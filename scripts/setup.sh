@@ -17,6 +17,7 @@ if [ -z "$build_dir" ]; then
 fi
 
 # chromium + a font: the report test loads out/index.html in headless Chromium.
+# (The viewer test also renders `atmos viewer`'s page there: WebGL2 on SwiftShader.)
 # python3-*, pybind11-dev: the Python module (import atmos, python/) and its
 # pytest suite, built for Debian's /usr/bin/python3; matplotlib: examples/.
 packages=(cmake g++ make ninja-build pkg-config libopenexr-dev libpng-dev nlohmann-json3-dev

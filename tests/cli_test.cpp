@@ -13,6 +13,8 @@
 #include <string>
 #include <utility>
 
+#include <nlohmann/json.hpp>
+
 #include "atmos/error.h"
 #include "atmos/image.h"
 #include "atmos/model.h"
@@ -106,6 +108,36 @@ TEST(Cli, RenderAllViewsWritesAGallery) {
     EXPECT_NE(html.find("naive-planet-shadow-ground.png"), std::string::npos);
 }
 
+// `atmos bake`: beside the EXR files, the raw blobs the JSON describes and the
+// shaders (bruneton; tiny tables, one order: this checks the files, not the sky).
+TEST(Cli, BakeWritesRawTablesAndShaders) {
+    const fs::path dir = TempDir() / "bake_raw";
+    fs::remove_all(dir);
+    const Result r = RunAtmos(
+        "bake --model bruneton:orders=1:scattering-r=4:scattering-mu=8:scattering-mu-s=4:"
+        "scattering-nu=2:transmittance-width=8:transmittance-height=4:irradiance-width=4:"
+        "irradiance-height=2 -q -o " +
+        dir.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(Slurp(dir / "bruneton.json"));
+    for (const char* format : {"float32", "float16"}) {
+        const auto& blob = j.at("raw").at(format);
+        EXPECT_EQ(fs::file_size(dir / blob.at("file").get<std::string>()),
+                  blob.at("bytes").get<size_t>());
+    }
+    const auto& s = j.at("raw").at("tables").at("scattering");
+    EXPECT_EQ(s.at("width"), 8);  // NU * MU_S
+    EXPECT_EQ(s.at("height"), 8);
+    EXPECT_EQ(s.at("depth"), 4);
+    EXPECT_EQ(s.at("channels"), 3);
+    EXPECT_TRUE(j.at("raw").at("tables").contains("single_mie_scattering"));
+    const std::string glsl = Slurp(dir / "shaders" / "bruneton.glsl");
+    EXPECT_NE(glsl.find("vec3 atmos_SkyRadiance("), std::string::npos);
+    const std::string constants = Slurp(dir / "shaders" / "bruneton_constants.glsl");
+    EXPECT_NE(constants.find("#define ATMOS_SCATTERING_MU 8\n"), std::string::npos);
+    EXPECT_NE(constants.find("#define ATMOS_COMBINED_MIE 0\n"), std::string::npos);
+}
+
 TEST(Cli, SampleFollowsTheContract) {
     const Result r = RunAtmos("sample --model naive",
                               "altitude_m,mu,mu_s,azimuth_deg\n0,1,1,0\n1000,-0.5,0.5,30\n");
@@ -170,6 +202,15 @@ TEST(Cli, ErrorPaths) {
     ExpectError("frobnicate", "frobnicate");
     ExpectError("bake --model naive -o " + (TempDir() / "bake").string(), "no precomputed tables");
     ExpectError("bake --model naive", "--output");
+    ExpectError("viewer --models atmosphere-plus -o " + (TempDir() / "viewer").string(),
+                "has no shaders");
+    ExpectError("viewer --models bruneton,bruneton --load /nonexistent -o " +
+                    (TempDir() / "viewer").string(),
+                "one model");
+    ExpectError("viewer --models bruneton", "--output");
+    ExpectError("viewer --model naive -o " + (TempDir() / "viewer").string(), "has no shaders");
+    ExpectError("viewer --model bruneton --models bruneton -o " + (TempDir() / "viewer").string(),
+                "not both");
     ExpectError("render --model naive --load /nonexistent" + o, "no precomputed tables to load");
     ExpectError("sample --model naive", "header", "");
     ExpectError("sample --model naive", "header", "a,b,c\n");

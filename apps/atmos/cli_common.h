@@ -55,6 +55,7 @@ Command AddListCommand(CLI::App* root);
 Command AddRenderCommand(CLI::App* root);
 Command AddSampleCommand(CLI::App* root);
 Command AddBakeCommand(CLI::App* root);
+Command AddViewerCommand(CLI::App* root);
 Command AddFlipCommand(CLI::App* root);
 Command AddRmseCommand(CLI::App* root);
 // compare records its command line (argc, argv) for the report.

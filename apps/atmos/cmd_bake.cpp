@@ -1,35 +1,211 @@
-// atmos CLI: `atmos bake`: a model's precomputed tables as files for other engines.
+// atmos CLI: `atmos bake`: a model's precomputed tables as files for other
+// engines (EXR, raw float32/float16, JSON) with the GLSL that reads them; and
+// `atmos viewer`: those, for the models with shaders, in a WebGL2 page.
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "atmos/error.h"
 #include "atmos/model.h"
 #include "base/parallel.h"
 #include "cli_common.h"
+#include "embedded_assets.h"
 
 namespace atmos::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// shaders/NAME.glsl for a model name ("atmosphere-plus" -> atmosphere_plus).
+std::string ShaderAsset(const std::string& model) {
+    std::string file = model;
+    for (char& c : file) {
+        if (c == '-') c = '_';
+    }
+    return "shaders/" + file + ".glsl";
+}
+
+void WriteText(const fs::path& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    if (!out) Fail("cannot write '", path.string(), "'");
+}
+
+std::string ReadFile(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) Fail("cannot read '", path.string(), "'");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+// Precomputes (or --load's) `common`'s model and bakes it into `dir`, shaders
+// included; returns the model's registered name.
+std::string BakeInto(const CommonOptions& common, const std::string& dir) {
+    const ModelSpec spec = GivenModel(common);
+    std::unique_ptr<Model> model = CreateModel(spec);
+    if (!model->CanBake()) Fail("model ", common.model, " has no precomputed tables to bake");
+    ThreadLimit limit(common.threads);
+    const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
+    const double seconds = PrepareModel(common, atmosphere, model.get());
+    fs::create_directories(dir);
+    model->Bake(dir);
+    if (const char* shader = FindAsset(ShaderAsset(spec.name))) {
+        fs::create_directories(fs::path(dir) / "shaders");
+        WriteText(fs::path(dir) / ShaderAsset(spec.name), shader);
+    }
+    if (!common.quiet) {
+        std::fprintf(stderr, "baked %s (precomputed in %.3f s) into %s\n", common.model.c_str(),
+                     seconds, dir.c_str());
+    }
+    return spec.name;
+}
+
+// A JavaScript string literal of `text`.
+std::string JsString(const std::string& text) {
+    std::string out = "\"";
+    for (const char c : text) {
+        switch (c) {
+            case '"':
+                out += "\\\"";
+                break;
+            case '\\':
+                out += "\\\\";
+                break;
+            case '\n':
+                out += "\\n";
+                break;
+            case '\r':
+                break;
+            case '<':
+                out += "\\x3c";
+                break;  // no "</script>" in a script
+            default:
+                out += c;
+        }
+    }
+    return out + "\"";
+}
+
+std::string Base64(const std::string& bytes) {
+    static const char* kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve((bytes.size() + 2) / 3 * 4);
+    size_t i = 0;
+    for (; i + 2 < bytes.size(); i += 3) {
+        const unsigned v = (static_cast<unsigned char>(bytes[i]) << 16) |
+                           (static_cast<unsigned char>(bytes[i + 1]) << 8) |
+                           static_cast<unsigned char>(bytes[i + 2]);
+        out += kDigits[(v >> 18) & 63];
+        out += kDigits[(v >> 12) & 63];
+        out += kDigits[(v >> 6) & 63];
+        out += kDigits[v & 63];
+    }
+    if (i < bytes.size()) {
+        unsigned v = static_cast<unsigned char>(bytes[i]) << 16;
+        if (i + 1 < bytes.size()) v |= static_cast<unsigned char>(bytes[i + 1]) << 8;
+        out += kDigits[(v >> 18) & 63];
+        out += kDigits[(v >> 12) & 63];
+        out += i + 1 < bytes.size() ? kDigits[(v >> 6) & 63] : '=';
+        out += '=';
+    }
+    return out;
+}
+
+// The page's view of one baked model: MODEL/model.js (its JSON and shaders)
+// and MODEL/tables_f32.js, MODEL/tables_f16.js (the raw blobs in base64):
+// scripts, so that the page works from file:// where fetch() is refused.
+void WriteViewerData(const fs::path& dir, const std::string& name) {
+    const std::string json = ReadFile(dir / (name + ".json"));
+    const std::string functions = ReadFile(dir / ShaderAsset(name));
+    std::string file = name;
+    for (char& c : file) {
+        if (c == '-') c = '_';
+    }
+    const std::string constants = ReadFile(dir / "shaders" / (file + "_constants.glsl"));
+    WriteText(dir / "model.js", "atmosViewerData.models[" + JsString(name) + "] = {bake: " + json +
+                                    ", constants: " + JsString(constants) +
+                                    ", functions: " + JsString(functions) + "};\n");
+    for (const char* format : {"f32", "f16"}) {
+        const std::string blob = ReadFile(dir / (std::string("tables.") + format));
+        WriteText(dir / (std::string("tables_") + format + ".js"),
+                  "atmosViewerData.tables[" + JsString(name + "/" + format) + "] = \"" +
+                      Base64(blob) + "\";\n");
+    }
+}
+
+}  // namespace
 
 Command AddBakeCommand(CLI::App* root) {
     auto common = std::make_shared<CommonOptions>();
     auto output = std::make_shared<std::string>();
     Command c;
     c.app = root->add_subcommand(
-        "bake", "precompute a model's lookup tables and write them (EXR + JSON) to a directory");
+        "bake",
+        "precompute a model's lookup tables and write them (EXR, raw float32/float16, JSON) and "
+        "the GLSL that reads them (DIR/shaders/) to a directory");
     AddCommonOptions(c.app, common.get());
     c.app->add_option("-o,--output", *output, "output directory")->required();
     c.run = [common, output] {
-        std::unique_ptr<Model> model = CreateModel(GivenModel(*common));
-        if (!model->CanBake()) Fail("model ", common->model, " has no precomputed tables to bake");
-        ThreadLimit limit(common->threads);
-        const AtmosphereParameters atmosphere = LoadAtmosphere(common->atmosphere, common->sets);
-        const double seconds = PrepareModel(*common, atmosphere, model.get());
-        std::filesystem::create_directories(*output);
-        model->Bake(*output);
+        BakeInto(*common, *output);
+        return 0;
+    };
+    return c;
+}
+
+Command AddViewerCommand(CLI::App* root) {
+    auto common = std::make_shared<CommonOptions>();
+    auto output = std::make_shared<std::string>();
+    auto models = std::make_shared<std::vector<std::string>>();
+    Command c;
+    c.app = root->add_subcommand(
+        "viewer",
+        "bake the models with shaders and write a self-contained WebGL2 sky viewer (open "
+        "DIR/index.html; no network)");
+    AddCommonOptions(c.app, common.get());
+    c.app->add_option("-o,--output", *output, "output directory")->required();
+    c.app
+        ->add_option("--models", *models,
+                     "models to bake, NAME[:OPTION=VALUE...] comma-separated (default: "
+                     "bruneton); with --load DIR, one model read from DIR")
+        ->delimiter(',');
+    CLI::Option* model_flag = c.app->get_option("--model");
+    c.run = [common, output, models, model_flag] {
+        std::vector<std::string> specs = *models;
+        if (model_flag->count() > 0) {
+            if (!specs.empty()) Fail("give --models or --model, not both");
+            specs.push_back(common->model);  // --model: one model, as for bake
+        }
+        if (specs.empty()) specs = {"bruneton", "hillaire"};
+        if (!common->load.empty() && specs.size() != 1) {
+            Fail("--load reads one model's tables: give one model in --models");
+        }
+        const fs::path dir(*output);
+        fs::create_directories(dir);
+        std::string list;
+        for (const std::string& spec : specs) {
+            CommonOptions one = *common;
+            one.model = spec;
+            const std::string name = ParseModelSpec(spec).name;
+            if (!FindAsset(ShaderAsset(name))) {
+                Fail("model ", name, " has no shaders (", ShaderAsset(name),
+                     "): the viewer shows bruneton and hillaire");
+            }
+            BakeInto(one, (dir / name).string());
+            WriteViewerData(dir / name, name);
+            list += (list.empty() ? "" : ", ") + JsString(name);
+        }
+        WriteText(dir / "index.html", FindAsset("viewer/index.html"));
+        WriteText(dir / "viewer.js", FindAsset("viewer/viewer.js"));
+        WriteText(dir / "models.js", "var atmosViewerModels = [" + list + "];\n");
         if (!common->quiet) {
-            std::fprintf(stderr, "baked %s (precomputed in %.3f s) into %s\n",
-                         common->model.c_str(), seconds, output->c_str());
+            std::fprintf(stderr, "viewer: open %s\n",
+                         (fs::absolute(dir) / "index.html").string().c_str());
         }
         return 0;
     };

@@ -20,15 +20,11 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     app.set_version_flag("--version", "atmos 0.1.0");
     const std::vector<Command> commands = {
-        AddListCommand(&app),
-        AddRenderCommand(&app),
-        AddSampleCommand(&app),
-        AddBakeCommand(&app),
-        AddFlipCommand(&app),
-        AddRmseCommand(&app),
-        AddCompareCommand(&app, argc, argv),
-        AddBenchCommand(&app),
-        AddLocCommand(&app),
+        AddListCommand(&app),   AddRenderCommand(&app),
+        AddSampleCommand(&app), AddBakeCommand(&app),
+        AddViewerCommand(&app), AddFlipCommand(&app),
+        AddRmseCommand(&app),   AddCompareCommand(&app, argc, argv),
+        AddBenchCommand(&app),  AddLocCommand(&app),
         AddFitCommand(&app),
     };
     try {

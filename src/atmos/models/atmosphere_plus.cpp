@@ -13,6 +13,7 @@
 
 #include "atmos/error.h"
 #include "base/parallel.h"
+#include "io/raw_tables.h"
 #include "io/table_io.h"
 #include "models/atmosphere_plus_stages.h"
 #include "models/option_json.h"
@@ -227,6 +228,10 @@ void AtmospherePlusModel::Bake(const std::string& directory) const {
     j["transmittance"] = {{"file", "transmittance.exr"},
                           {"layout", "W x H: altitude (u) x view zenith (v), same mapping"}};
     j["atmosphere"] = nlohmann::json::parse(AtmosphereToJson(atm_));
+    j["raw"] =
+        nlohmann::json::parse(WriteRawTables(directory, {{"scattering", &tables_.scattering},
+                                                         {"transmittance", &tables_.transmittance}})
+                                  .dump());
     std::ofstream out(fs::path(directory) / "atmosphere-plus.json");
     out << j.dump(2) << "\n";
     if (!out) Fail("atmosphere-plus: cannot write ", directory, "/atmosphere-plus.json");

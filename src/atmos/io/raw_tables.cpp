@@ -1,0 +1,108 @@
+#include "io/raw_tables.h"
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "atmos/error.h"
+
+namespace atmos {
+
+uint16_t FloatToHalf(float x) {
+    if (!std::isfinite(x)) {
+        if (std::isnan(x)) return 0;
+        x = x > 0.0f ? 65504.0f : -65504.0f;
+    }
+    uint32_t bits;
+    std::memcpy(&bits, &x, 4);
+    const uint16_t sign = static_cast<uint16_t>((bits >> 16) & 0x8000u);
+    const uint32_t abs_bits = bits & 0x7fffffffu;
+    float a;
+    std::memcpy(&a, &abs_bits, 4);
+    if (a >= 65520.0f) return static_cast<uint16_t>(sign | 0x7bffu);  // rounds past the max
+    if (a < 5.9604645e-8f * 0.5f) return sign;                        // below half the smallest
+    const int exponent = static_cast<int>(abs_bits >> 23) - 127;
+    if (exponent < -14) {
+        // Subnormal: value = m * 2^-24, m in [0, 1024); round to nearest even.
+        const double m = static_cast<double>(a) * 16777216.0;
+        double r = std::nearbyint(m);  // default rounding mode: to nearest even
+        return static_cast<uint16_t>(sign | static_cast<uint16_t>(r));
+    }
+    // Normal: keep 10 mantissa bits, round to nearest even on the 13 dropped.
+    uint32_t mantissa = abs_bits & 0x7fffffu;
+    uint32_t e = static_cast<uint32_t>(exponent + 15);
+    uint32_t h = (e << 10) | (mantissa >> 13);
+    const uint32_t rest = mantissa & 0x1fffu;
+    if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h;  // may carry into the exponent
+    return static_cast<uint16_t>(sign | h);
+}
+
+float HalfToFloat(uint16_t h) {
+    const float sign = (h & 0x8000u) ? -1.0f : 1.0f;
+    const int e = (h >> 10) & 0x1f;
+    const int m = h & 0x3ff;
+    if (e == 0) return sign * std::ldexp(static_cast<float>(m), -24);
+    if (e == 31) return sign * 65504.0f;  // never written
+    return sign * std::ldexp(static_cast<float>(1024 + m), e - 25);
+}
+
+namespace {
+
+constexpr size_t kAlign = 256;
+
+size_t AlignUp(size_t n) { return (n + kAlign - 1) / kAlign * kAlign; }
+
+void WriteFile(const std::string& path, const std::vector<unsigned char>& bytes) {
+    std::ofstream out(path, std::ios::binary);
+    if (!out) Fail("cannot write '", path, "'");
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
+    if (!out) Fail("cannot write '", path, "'");
+}
+
+void PutLe(std::vector<unsigned char>* out, size_t at, uint32_t v, int bytes) {
+    for (int i = 0; i < bytes; ++i) (*out)[at + i] = static_cast<unsigned char>(v >> (8 * i));
+}
+
+}  // namespace
+
+nlohmann::ordered_json WriteRawTables(const std::string& directory,
+                                      const std::vector<RawTable>& tables) {
+    std::vector<unsigned char> f32, f16;
+    nlohmann::ordered_json list = nlohmann::ordered_json::object();
+    for (const RawTable& t : tables) {
+        const Table& table = *t.table;
+        const size_t n = table.size();
+        const size_t o32 = AlignUp(f32.size()), o16 = AlignUp(f16.size());
+        f32.resize(o32 + 4 * n, 0);
+        f16.resize(o16 + 2 * n, 0);
+        for (size_t i = 0; i < n; ++i) {
+            uint32_t bits;
+            std::memcpy(&bits, table.data() + i, 4);
+            PutLe(&f32, o32 + 4 * i, bits, 4);
+            PutLe(&f16, o16 + 2 * i, FloatToHalf(table.data()[i]), 2);
+        }
+        list[t.name] = {{"width", table.width()},
+                        {"height", table.height()},
+                        {"depth", table.depth()},
+                        {"channels", table.channels()},
+                        {"values", n},
+                        {"float32_offset", o32},
+                        {"float16_offset", o16}};
+    }
+    namespace fs = std::filesystem;
+    WriteFile((fs::path(directory) / "tables.f32").string(), f32);
+    WriteFile((fs::path(directory) / "tables.f16").string(), f16);
+    nlohmann::ordered_json j;
+    j["description"] =
+        "every table in two blobs, little-endian: float32 and IEEE half (round to nearest even, "
+        "clamped to 65504); a W x H x D table with C channels is W*H*D*C values, channel fastest, "
+        "then x (u), y (v), z (layer): the order glTexImage2D/3D reads; offsets in bytes";
+    j["float32"] = {{"file", "tables.f32"}, {"bytes", f32.size()}};
+    j["float16"] = {{"file", "tables.f16"}, {"bytes", f16.size()}};
+    j["tables"] = list;
+    return j;
+}
+
+}  // namespace atmos

@@ -1,0 +1,37 @@
+// atmos: baked tables in a raw layout an engine loads without an EXR library.
+//
+// `atmos bake` writes, beside the EXR files, every table of the bake into two
+// blobs: DIR/tables.f32 (little-endian IEEE float32) and DIR/tables.f16
+// (little-endian IEEE half, round to nearest even, clamped to +-65504). In both,
+// a table of W x H x D texels with C channels is W*H*D*C consecutive values:
+// channel fastest, then x (texture u), then y (v), then z (layer): exactly what
+// glTexImage2D/3D reads for a GL_RGB/GL_RGBA texture of W x H (x D). Each
+// table starts at a multiple of 256 bytes. The JSON under "raw" gives the files,
+// byte sizes and, per table, its sizes and byte offsets in both blobs.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "base/texture.h"
+
+namespace atmos {
+
+struct RawTable {
+    std::string name;
+    const Table* table;
+};
+
+// Writes DIR/tables.f32 and DIR/tables.f16; returns their description (the
+// bake JSON's "raw"). Throws atmos::Error when a file cannot be written.
+nlohmann::ordered_json WriteRawTables(const std::string& directory,
+                                      const std::vector<RawTable>& tables);
+
+// IEEE 754 binary16 bits of x: round to nearest even, +-65504 for larger
+// magnitudes (no infinities), subnormals kept, NaN to 0.
+uint16_t FloatToHalf(float x);
+float HalfToFloat(uint16_t h);
+
+}  // namespace atmos
