@@ -441,13 +441,13 @@ struct BrunetonLut {
         // the Mie phase's forward peak magnifies them). That fade also removes
         // the real sunset glow over the ground (issue 15), so by default the
         // faded part is replaced by the single Mie integral along the segment
-        // itself, which has no difference to go wrong.
+        // itself (to the point, or shadow_length before it), which has no
+        // difference to go wrong.
         const double fade = SmoothStep(0.0, 0.01, mu_s);
         if (cfg.low_sun_mie != 2 && fade < 1.0) {
             single_mie = single_mie * static_cast<float>(fade);
             if (cfg.low_sun_mie == 0) {
-                single_mie += SegmentSingleMie(r, mu, mu_s, nu, Length(point - camera)) *
-                              static_cast<float>(1.0 - fade);
+                single_mie += SegmentSingleMie(r, mu, mu_s, nu, d) * static_cast<float>(1.0 - fade);
             }
         }
         return Max(scattering, Rgb(0.0f)) * static_cast<float>(RayleighPhase(nu)) +
