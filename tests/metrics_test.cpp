@@ -253,6 +253,40 @@ TEST(Flip, HdrWithBlackPixelsIsFiniteAndCorrect) {
     EXPECT_GT(bw.mean, 0.5);
 }
 
+TEST(Flip, ThesisExposureSetupAddsOneNanoToEveryPixel) {
+    // `--exposure thesis` (seed 003 section 11.5): the same as HDR-FLIP of the
+    // images with 1e-9 added to every channel; with more than half of the
+    // pixels black its median is ~1e-9, so the exposure range reaches ~30 stops
+    // further than atmos's median over the non-black pixels, and the mean
+    // differs (the gap to the thesis's Appendix A in orbit and space views).
+    // Sky at the top, black below, and a faint band (1e-6, twice as bright in
+    // the test) that atmos's exposures (down to the sky's median) leave black.
+    Image ref = SkyImage(64, 40), test = SkyImage(64, 40, 1.2f);
+    for (int y = 8; y < 40; ++y) {
+        for (int x = 0; x < 64; ++x) {
+            const float f = y >= 36 ? 1e-6f : 0.0f;
+            ref.Set(x, y, Rgb(f, f, f));
+            test.Set(x, y, Rgb(2.0f * f, 2.0f * f, 2.0f * f));
+        }
+    }
+    Image ref_eps = ref, test_eps = test;
+    for (size_t i = 0; i < ref.size(); ++i) {
+        ref_eps.data()[i] += 1e-9f;
+        test_eps.data()[i] += 1e-9f;
+    }
+    FlipOptions thesis;
+    thesis.exposure_setup = FlipExposureSetup::kThesis;
+    const FlipResult t = HdrFlip(ref, test, thesis);
+    const FlipResult eps = HdrFlip(ref_eps, test_eps);
+    const FlipResult atmos = HdrFlip(ref, test);
+    EXPECT_EQ(t.mean, eps.mean);
+    EXPECT_EQ(t.exposures.count, eps.exposures.count);
+    EXPECT_GT(t.exposures.stop, atmos.exposures.stop + 20.0);
+    EXPECT_GT(t.mean, atmos.mean + 1e-3);  // the faint band's error counts
+    EXPECT_STREQ(FlipExposureSetupName(ParseFlipExposureSetup("thesis")), "thesis");
+    EXPECT_THROW(ParseFlipExposureSetup("median"), Error);
+}
+
 TEST(Flip, RejectsMismatchedSizes) {
     EXPECT_THROW(HdrFlip(Image(4, 4), Image(4, 5)), Error);
     EXPECT_THROW(LdrFlip(Image(), Image()), Error);

@@ -294,5 +294,66 @@ TEST(Neural, MalformedOrMismatchedWeightsAreClearErrors) {
     EXPECT_THROW(m->Prepare(atm), Error);
 }
 
+TEST(Neural, WeightsCheckCoversEveryFieldTheFitDependsOn) {
+    // The shipped weights were fitted to `earth` (ground albedo 0): a ground
+    // albedo of 0.3 changes the reference's multiple scattering (36.7 % median
+    // error, issue 15), as do the density profiles, the sun's radius and
+    // mu_s_min; each is one clear error naming the field and `atmos fit`.
+    const AtmosphereParameters atm = EarthAtmosphere();
+    const NeuralWeights w = EmbeddedNeuralWeights("earth");
+    ASSERT_TRUE(w.has_fit_atmosphere);
+    EXPECT_NO_THROW(CheckNeuralWeightsMatch(w, atm, "earth"));
+    AtmosphereParameters sun = atm;  // only scales the output
+    sun.solar_irradiance = Vec3d(1.5, 1.6, 1.7);
+    EXPECT_NO_THROW(CheckNeuralWeightsMatch(w, sun, "earth"));
+    auto refused_by = [](const NeuralWeights& ww, const AtmosphereParameters& other,
+                         const std::string& field) {
+        try {
+            CheckNeuralWeightsMatch(ww, other, "earth");
+            ADD_FAILURE() << field << ": accepted";
+        } catch (const Error& e) {
+            const std::string m = e.what();
+            EXPECT_NE(m.find(field), std::string::npos) << m;
+            EXPECT_NE(m.find("atmos fit"), std::string::npos) << m;
+        }
+    };
+    auto expect_refused = [&](const AtmosphereParameters& other, const std::string& field) {
+        refused_by(w, other, field);
+    };
+    AtmosphereParameters a = atm;
+    a.ground_albedo = Vec3d(0.3);
+    expect_refused(a, "ground_albedo");
+    a = atm;
+    a.mie_density = ExponentialProfile(2000.0);
+    expect_refused(a, "mie_density");
+    a = atm;
+    a.rayleigh_density = ExponentialProfile(7000.0);
+    expect_refused(a, "rayleigh_density");
+    a = atm;
+    a.absorption_density.layers[0].width *= 1.1;
+    expect_refused(a, "absorption_density");
+    a = atm;
+    a.sun_angular_radius *= 2.0;
+    expect_refused(a, "sun_angular_radius");
+    a = atm;
+    a.mu_s_min = -0.5;
+    expect_refused(a, "mu_s_min");
+    // The CLI path: the model refuses to prepare.
+    std::unique_ptr<Model> m = CreateModel("neural", {});
+    a = atm;
+    a.ground_albedo = Vec3d(0.3);
+    EXPECT_THROW(m->Prepare(a), Error);
+    // Weights that do not record the whole atmosphere are refused too.
+    std::string text = NeuralWeightsToJson(w);
+    const NeuralWeights round = NeuralWeightsFromJson(text, "round.json");
+    EXPECT_TRUE(round.has_fit_atmosphere);
+    EXPECT_NO_THROW(CheckNeuralWeightsMatch(round, atm, "round.json"));
+    NeuralWeights old = w;
+    old.has_fit_atmosphere = false;
+    const NeuralWeights old_read = NeuralWeightsFromJson(NeuralWeightsToJson(old), "old.json");
+    EXPECT_FALSE(old_read.has_fit_atmosphere);
+    refused_by(old_read, atm, "fit_atmosphere");
+}
+
 }  // namespace
 }  // namespace atmos

@@ -43,6 +43,7 @@ struct CompareCliOptions {
     std::string backend = "cpu";
     double ppd = 0.0;
     std::string tone_mapper = "aces";
+    std::string exposure = "atmos";
     std::string command_line;
 };
 
@@ -73,6 +74,7 @@ int CmdCompare(const CompareCliOptions& o) {
     CheckFlipPpd(o.ppd);
     config.flip.ppd = o.ppd;
     config.flip.tone_mapper = ParseFlipToneMapper(o.tone_mapper);
+    config.flip.exposure_setup = ParseFlipExposureSetup(o.exposure);
     config.command_line = o.command_line;
 
     // The reference: `reference` (the path tracer) when registered, else a stand-in.
@@ -152,6 +154,10 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
     cmd->add_flag("--no-npy", o->no_npy, "do not write .npy images");
     cmd->add_option("--ppd", o->ppd, "FLIP pixels per degree (default 67.0206)");
     cmd->add_option("--tonemapper", o->tone_mapper, "HDR-FLIP tone mapper: aces, hable, reinhard")
+        ->capture_default_str();
+    cmd->add_option("--exposure", o->exposure,
+                    "HDR-FLIP black pixels: atmos (exposure median over the non-black pixels) or "
+                    "thesis (seed 003 section 11.5: 1e-9 added to every pixel)")
         ->capture_default_str();
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
         ->check(CLI::NonNegativeNumber);

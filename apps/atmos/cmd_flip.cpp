@@ -14,7 +14,7 @@ namespace atmos::cli {
 namespace {
 
 struct FlipCliOptions {
-    std::string reference, test, output, mode = "auto", tone_mapper = "aces";
+    std::string reference, test, output, mode = "auto", tone_mapper = "aces", exposure = "atmos";
     double ppd = 0.0;
     double start = 0.0, stop = 0.0;
     int exposures = 0;
@@ -27,6 +27,7 @@ int CmdFlip(const FlipCliOptions& o) {
     FlipOptions options;
     options.ppd = o.ppd;
     options.tone_mapper = ParseFlipToneMapper(o.tone_mapper);
+    options.exposure_setup = ParseFlipExposureSetup(o.exposure);
     options.has_start_exposure = o.start_flag->count() > 0;
     options.start_exposure = o.start;
     options.has_stop_exposure = o.stop_flag->count() > 0;
@@ -46,9 +47,10 @@ int CmdFlip(const FlipCliOptions& o) {
     const FlipResult r = hdr ? HdrFlip(ref, test, options) : LdrFlip(ref, test, options);
     const double ppd = options.ppd > 0.0 ? options.ppd : FlipDefaultPpd();
     if (hdr) {
-        std::printf("HDR-FLIP, tone mapper %s, ppd %.4f, exposures %.4f to %.4f (%d)\n",
-                    FlipToneMapperName(options.tone_mapper), ppd, r.exposures.start,
-                    r.exposures.stop, r.exposures.count);
+        std::printf(
+            "HDR-FLIP, tone mapper %s, exposure setup %s, ppd %.4f, exposures %.4f to %.4f (%d)\n",
+            FlipToneMapperName(options.tone_mapper), FlipExposureSetupName(options.exposure_setup),
+            ppd, r.exposures.start, r.exposures.stop, r.exposures.count);
     } else {
         std::printf("LDR-FLIP, ppd %.4f\n", ppd);
     }
@@ -78,6 +80,10 @@ Command AddFlipCommand(CLI::App* root) {
                     "error map: .png (magma colour map), or .exr .npy .pfm (values)");
     cmd->add_option("--ppd", o->ppd, "pixels per degree (default 67.0206: 0.7 m, 0.7 m, 3840 px)");
     cmd->add_option("--tonemapper", o->tone_mapper, "HDR tone mapper: aces, hable, reinhard")
+        ->capture_default_str();
+    cmd->add_option("--exposure", o->exposure,
+                    "HDR black pixels: atmos (exposure median over the non-black pixels) or thesis "
+                    "(seed 003 section 11.5: 1e-9 added to every pixel, median over all)")
         ->capture_default_str();
     cmd->add_option("--mode", o->mode, "auto (PNG reference: LDR), ldr or hdr")
         ->capture_default_str();

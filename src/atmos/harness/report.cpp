@@ -171,13 +171,32 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
     item("size", std::to_string(config.width) + "x" + std::to_string(config.height));
     item("atmosphere", config.atmosphere_name);
     const double ppd = config.flip.ppd > 0.0 ? config.flip.ppd : FlipDefaultPpd();
-    item("metric", transmittance
-                       ? "LDR-FLIP (transmittance as linear RGB in [0, 1]), RMSE"
-                       : std::string("HDR-FLIP (tone mapper ") +
-                             FlipToneMapperName(config.flip.tone_mapper) +
-                             ", exposure range from the reference), RMSE over all channels");
+    item("metric", transmittance ? "LDR-FLIP (transmittance as linear RGB in [0, 1]), RMSE"
+                                 : std::string("HDR-FLIP (tone mapper ") +
+                                       FlipToneMapperName(config.flip.tone_mapper) +
+                                       ", exposure range from the reference, black pixels: " +
+                                       (config.flip.exposure_setup == FlipExposureSetup::kThesis
+                                            ? "thesis (1e-9 added to every pixel, seed 003 11.5)"
+                                            : "atmos (median over non-black pixels)") +
+                                       "), RMSE over all channels");
     item("pixels per degree", Fixed(ppd, 4));
     item("models", std::to_string(r.models.size()));
+    // Each model's options as compared (the defaults unless the spec sets
+    // them): the defaults change between rounds (issue 15).
+    for (const std::string& m : r.models) {
+        std::string opts;
+        try {
+            const ModelSpec spec = ParseModelSpec(m);
+            for (const ModelOptionSpec& o : GetModelInfo(spec.name).options) {
+                const auto given = spec.options.find(o.name);
+                opts += (opts.empty() ? "" : " ") + o.name + "=" +
+                        (given != spec.options.end() ? given->second : o.default_value);
+            }
+        } catch (const Error&) {
+            continue;  // not a registered model spec: nothing to list
+        }
+        item("options of " + m, opts.empty() ? "(none)" : opts);
+    }
     item("views", std::to_string(r.rows.size()));
     item("command", config.command_line);
     item("CPU", CpuName());

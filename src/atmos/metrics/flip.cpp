@@ -478,8 +478,30 @@ FlipExposureRange FlipComputeExposureRange(const Image& reference, const FlipOpt
     return r;
 }
 
+FlipExposureSetup ParseFlipExposureSetup(const std::string& name) {
+    if (name == "atmos") return FlipExposureSetup::kAtmos;
+    if (name == "thesis") return FlipExposureSetup::kThesis;
+    Fail("--exposure must be atmos or thesis, got '", name, "'");
+}
+const char* FlipExposureSetupName(FlipExposureSetup s) {
+    return s == FlipExposureSetup::kThesis ? "thesis" : "atmos";
+}
+
 FlipResult HdrFlip(const Image& reference, const Image& test, const FlipOptions& options) {
     CheckPair(reference, test);
+    if (options.exposure_setup == FlipExposureSetup::kThesis) {
+        // Seed 003 section 11.5: 1e-9 added to every channel of every pixel.
+        auto offset = [](const Image& in) {
+            Image out = in;
+            float* d = out.data();
+            const size_t n = static_cast<size_t>(out.width()) * out.height() * 3;
+            for (size_t i = 0; i < n; ++i) d[i] += kFlipThesisOffset;
+            return out;
+        };
+        FlipOptions plain = options;
+        plain.exposure_setup = FlipExposureSetup::kAtmos;
+        return HdrFlip(offset(reference), offset(test), plain);
+    }
     FlipResult r;
     r.hdr = true;
     r.width = reference.width();

@@ -40,8 +40,20 @@ constexpr double kFlipMaxPpd = 1e4;
 // Throws atmos::Error unless ppd is 0 (the default) or in (0, kFlipMaxPpd].
 void CheckFlipPpd(double ppd);
 
+// HDR-FLIP's handling of black pixels (issue 15). kAtmos: the deviation
+// above (median over the positive luminances when the median is 0). kThesis:
+// seed 003 section 11.5, "a value of 1e-9 is added to the color channels of
+// every pixel" of both images, then spec 3.2 unchanged (the median over all
+// pixels, which is about 1e-9 when half of them were black: many more
+// exposures, each brightening the dark part).
+enum class FlipExposureSetup { kAtmos, kThesis };
+FlipExposureSetup ParseFlipExposureSetup(const std::string& name);  // atmos | thesis
+const char* FlipExposureSetupName(FlipExposureSetup s);
+constexpr float kFlipThesisOffset = 1e-9f;
+
 struct FlipOptions {
-    double ppd = 0.0;  // <= 0: FlipDefaultPpd()
+    double ppd = 0.0;                                              // <= 0: FlipDefaultPpd()
+    FlipExposureSetup exposure_setup = FlipExposureSetup::kAtmos;  // HDR only
     FlipToneMapper tone_mapper = FlipToneMapper::kAces;
     // HDR only: user-given exposure range (spec 3.2); each replaces the computed value alone.
     bool has_start_exposure = false;

@@ -132,10 +132,10 @@ const OptionTable<AplusSettings>& AtmospherePlusModel::OptionRows() {
                      "trapezoidal intervals along rays (seed: 30)")
             .ShapesTables()
             .Integer("gather-theta", &S::gather_theta, 1, 1000, "",
-                     "2D trapezoid intervals over Theta in [0, pi]")
+                     "2D trapezoid intervals over Theta in [0, pi] (the author's solver: 6)")
             .ShapesTables()
             .Integer("gather-phi", &S::gather_phi, 1, 2000, "",
-                     "2D trapezoid intervals over Phi in [0, 2 pi]")
+                     "2D trapezoid intervals over Phi in [0, 2 pi] (the author's solver: 12)")
             .ShapesTables()
             .Real("p-u", mapping(&AplusMapping::p_u), 0.1, 10, "",
                   "power p_u of u (power, horizon)")

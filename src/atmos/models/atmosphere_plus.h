@@ -162,8 +162,8 @@ struct AplusSettings {
     // (atmosphere-plus repository, atmo_solver.c: ATMO_K, ATMO_GATHER_M/N_STEPS).
     int orders = 5;                  // K
     int transmittance_steps = 30;    // seed 000 1.10: n = 30
-    int gather_theta = 6;            // 2D trapezoid intervals over Theta in [0, pi]
-    int gather_phi = 12;             // ... over Phi in [0, 2 pi]
+    int gather_theta = 12;           // 2D trapezoid intervals over Theta in [0, pi] (author's: 6)
+    int gather_phi = 24;             // ... over Phi in [0, 2 pi] (author's: 12; issue 15)
     bool modified_rayleigh = false;  // seed 000 1.7
 };
 

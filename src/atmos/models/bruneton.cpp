@@ -43,12 +43,23 @@ const OptionTable<BrunetonConfig>& BrunetonModel::OptionRows() {
             .Integer("orders", &C::orders, 1, 32, "", "scattering orders (1 = single scattering)")
             .ShapesTables()
             .Integer("scattering-samples", &C::scattering_samples, 1, 1000, "",
-                     "trapezoid intervals along view rays in single and multiple scattering")
+                     "intervals along view rays in single and multiple scattering")
+            .ShapesTables()
+            .Choice("scattering-rule", &C::scattering_rule, {{"simpson", 1}, {"trapezoid", 0}},
+                    "quadrature along view rays: Simpson's rule, or the seed's trapezoid "
+                    "(scattering-rule=trapezoid reproduces seed 004)")
             .ShapesTables()
             .Choice("mie-storage", &C::combined_mie, {{"separate", false}, {"combined", true}},
                     "single Mie scattering in its own table, or combined (red in the scattering "
                     "table's alpha, green and blue extrapolated)")
             .ShapesTables()
+            .Choice("low-sun-mie", &C::low_sun_mie,
+                    {{"integrate", 0}, {"smoothstep", 1}, {"lookup", 2}},
+                    "single Mie on rays to the ground with the sun below mu_s = 0.01: integrated "
+                    "along the segment, the seed's smoothstep(0, 0.01, mu_s) fade, or the two "
+                    "lookups subtracted (the artefact the fade hides)")
+            .Integer("low-sun-mie-steps", &C::low_sun_mie_steps, 1, 4096, "",
+                     "midpoint samples of the low-sun single Mie integral")
             .Integer("transmittance-width", &C::transmittance_width, 2, 4096, "",
                      "transmittance table: mu texels")
             .ShapesTables()

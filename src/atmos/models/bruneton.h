@@ -64,10 +64,31 @@ struct BrunetonConfig {
     int scattering_mu = 128;  // even: half for rays hitting the ground
     int scattering_mu_s = 32;
     int scattering_nu = 8;
-    int orders = 4;               // scattering orders (1 = single scattering only)
-    int scattering_samples = 50;  // trapezoid intervals along view rays (seed 004: 50)
-    bool combined_mie = false;    // Mie red in the scattering table's alpha
+    int orders = 4;                // scattering orders (1 = single scattering only)
+    int scattering_samples = 100;  // intervals along view rays (seed 004: 50)
+    // Quadrature along view rays in single and multiple scattering: Simpson's
+    // rule (default, issue 15) or the seed's trapezoid.
+    int scattering_rule = 1;    // 0: trapezoid (seed 004), 1: Simpson
+    bool combined_mie = false;  // Mie red in the scattering table's alpha
+    // Single Mie scattering of rays to the ground (aerial perspective) with the
+    // sun low (mu_s < 0.01): 0: integrated along the segment (default), 1: the
+    // seed's smoothstep(0, 0.01, mu_s) fade, 2: the two lookups subtracted as
+    // for a high sun (the artefact the seed's fade hides; for study only).
+    int low_sun_mie = 0;
+    int low_sun_mie_steps = 64;  // midpoint samples of that integral
 };
+
+// The view-ray quadrature's weight of sample i of n (times the interval):
+// the seed's trapezoid, or composite Simpson (odd n: Simpson's 3/8 rule on the
+// last three intervals; n = 1: trapezoid).
+ATMOS_HD inline double BrunetonQuadratureWeight(int rule, int i, int n) {
+    if (rule == 0 || n < 2) return (i == 0 || i == n) ? 0.5 : 1.0;
+    const int m = n % 2 == 0 ? n : n - 3;  // intervals of the 1/3 rule
+    double w = 0.0;
+    if (i <= m && m > 0) w += (i == 0 || i == m) ? 1.0 / 3.0 : (i % 2 == 1 ? 4.0 / 3.0 : 2.0 / 3.0);
+    if (i >= m && m != n) w += (i == m || i == n) ? 3.0 / 8.0 : 9.0 / 8.0;
+    return w;
+}
 
 // The lookup functions of seed 004 over a set of tables (trivially copyable;
 // used both by the precomputation, over its intermediate tables, and by the
@@ -414,11 +435,47 @@ struct BrunetonLut {
             s.w = single_mie.x;
             single_mie = ExtrapolatedSingleMie(s);
         }
-        // Seed 004's hack against artefacts with the sun below the horizon.
-        single_mie = single_mie * static_cast<float>(SmoothStep(0.0, 0.01, mu_s));
+        // Seed 004 fades single Mie out below mu_s = 0.01 ("hack to avoid
+        // rendering artifacts when the sun is below the horizon": the two
+        // lookups' interpolation errors do not cancel in the difference, and
+        // the Mie phase's forward peak magnifies them). That fade also removes
+        // the real sunset glow over the ground (issue 15), so by default the
+        // faded part is replaced by the single Mie integral along the segment
+        // itself (to the point, or shadow_length before it), which has no
+        // difference to go wrong.
+        const double fade = SmoothStep(0.0, 0.01, mu_s);
+        if (cfg.low_sun_mie != 2 && fade < 1.0) {
+            single_mie = single_mie * static_cast<float>(fade);
+            if (cfg.low_sun_mie == 0) {
+                single_mie += SegmentSingleMie(r, mu, mu_s, nu, d) * static_cast<float>(1.0 - fade);
+            }
+        }
         return Max(scattering, Rgb(0.0f)) * static_cast<float>(RayleighPhase(nu)) +
                Max(single_mie, Rgb(0.0f)) *
                    static_cast<float>(CornetteShanksPhase(atm.mie_phase_g, nu));
+    }
+
+    // Single Mie scattering (without the phase function) between the camera at
+    // (r, mu, mu_s, nu) and the point at distance d: the midpoint rule in
+    // cfg.low_sun_mie_steps samples, the view ray's transmittance from the
+    // extinction accumulated along the segment, the sun's from the table
+    // (GetTransmittanceToSun, as in the precomputed single scattering).
+    ATMOS_HD Rgb SegmentSingleMie(double r, double mu, double mu_s, double nu, double d) const {
+        const int n = cfg.low_sun_mie_steps;
+        const double dt = d / n;
+        Vec3d tau;
+        Vec3d sum;
+        for (int i = 0; i < n; ++i) {
+            const double t = (i + 0.5) * dt;
+            const double r_t = ClampRadius(Sqrt(t * t + 2.0 * r * mu * t + r * r));
+            const Densities rho = GetDensities(atm, r_t - atm.bottom_radius);
+            const Vec3d ext = Extinction(atm, rho);
+            const Vec3d tau_mid = tau + ext * (0.5 * dt);
+            tau += ext * dt;
+            const Rgb ts = TransmittanceToSun(r_t, ClampCosine((r * mu_s + t * nu) / r_t));
+            sum += Vec3d(ts) * Exp(-tau_mid) * (rho.mie * dt);
+        }
+        return Rgb(sum * atm.mie_scattering);
     }
 
     // GetSunAndSkyIrradiance (per unit solar irradiance) at `point` with

@@ -32,11 +32,6 @@ constexpr int kBrunetonIrradianceSamples = 32;      // ComputeIndirectIrradiance
 constexpr int kBrunetonDirections = kBrunetonDensityThetaSamples * 2 * kBrunetonDensityThetaSamples;
 constexpr int kBrunetonLanes = 8;  // independent partial sums (the CPU vectorises them)
 
-// Trapezoid weights of seed 004 (0.5 at both ends).
-ATMOS_HD inline double BrunetonTrapezoidWeight(int i, int n) {
-    return (i == 0 || i == n) ? 0.5 : 1.0;
-}
-
 ATMOS_HD inline Vec4f BrunetonVec4(const Rgb& c, float w = 0.0f) { return {c.x, c.y, c.z, w}; }
 
 // Texel (x, y, z) of a table `width` x `height` x depth from a flat item index.
@@ -119,7 +114,7 @@ ATMOS_HD inline BrunetonSingleSample BrunetonSingleScatteringSample(const Brunet
     s.r = lut.ClampRadius(Sqrt(d * d + 2.0 * r * mu * d + r * r));
     const Rgb t = lut.Transmittance(r, mu, d, ground);
     const double alt = s.r - atm.bottom_radius;
-    const float w = static_cast<float>(BrunetonTrapezoidWeight(i, n));
+    const float w = static_cast<float>(BrunetonQuadratureWeight(lut.cfg.scattering_rule, i, n));
     s.t_rayleigh = t * static_cast<float>(GetProfileDensity(atm.rayleigh_density, alt)) * w;
     s.t_mie = t * static_cast<float>(GetProfileDensity(atm.mie_density, alt)) * w;
     return s;
@@ -558,7 +553,7 @@ ATMOS_HD inline BrunetonMultipleSample BrunetonMultipleScatteringSample(
     lut.ScatteringUMuR(s.r, mu_i, ground, &u_mu, &u_r);
     fast.MakeRows(u_mu, u_r, &s.rows);
     s.t = lut.Transmittance(r, mu, d, ground) *
-          static_cast<float>(BrunetonTrapezoidWeight(i, n) * dx);
+          static_cast<float>(BrunetonQuadratureWeight(lut.cfg.scattering_rule, i, n) * dx);
     return s;
 }
 // The nu coordinate of the 4D lookup (BrunetonLut::Lookup4D): floor and fraction.

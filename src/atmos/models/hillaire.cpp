@@ -61,8 +61,8 @@ const OptionTable<HillaireOptions>& HillaireModel::OptionRows() {
             .Integer("ap-steps-per-slice", &O::ap_steps_per_slice, 1, 1e4, "",
                      "aerial-perspective march segments per slice")
             .Real("segment-offset", &O::segment_offset, 0, 1, "",
-                  "position of the sample inside each march segment (0.3: the paper's demo, 0.5: "
-                  "midpoint)")
+                  "position of the sample inside each march segment (0.5: midpoint; 0.3: the "
+                  "paper's demo)")
             .Choice("ground-path", &O::ground_from_ap,
                     {{"aerial-perspective", true}, {"sky-view", false}},
                     "in-scatter and transmittance of ground rays (camera inside): from the aerial-"

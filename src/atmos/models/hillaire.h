@@ -430,11 +430,11 @@ class HillaireFrame {
 
 struct HillaireOptions {
     int steps = 40;                // ray-march steps for cameras outside the atmosphere
-    int sky_view_steps = 30;       // per sky-view texel
+    int sky_view_steps = 100;      // per sky-view texel (demo: 30; issue 15)
     int transmittance_steps = 40;  // of the transmittance table
     double ap_km_per_slice = 4.0;  // aerial-perspective depth scale
     int ap_steps_per_slice = 4;
-    double segment_offset = 0.3;     // sample position inside a march segment (demo: 0.3)
+    double segment_offset = 0.5;     // sample position inside a march segment (demo: 0.3)
     bool ground_from_ap = true;      // ground rays from the aerial-perspective volume
     bool sample_with_tables = true;  // sample through sky-view tables (false: march)
 };

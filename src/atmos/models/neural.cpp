@@ -193,6 +193,11 @@ NeuralWeights NeuralWeightsFromJson(const std::string& text, const std::string& 
             Vec3FromJson(a.value("mie_extinction", json()), "atmosphere.mie_extinction");
         w.absorption_extinction = Vec3FromJson(a.value("absorption_extinction", json()),
                                                "atmosphere.absorption_extinction");
+        if (j.contains("fit_atmosphere")) {
+            if (!j["fit_atmosphere"].is_object()) Fail("fit_atmosphere: expected an object");
+            w.fit_atmosphere = AtmosphereFromJson(j["fit_atmosphere"].dump(), "fit_atmosphere");
+            w.has_fit_atmosphere = true;
+        }
         if (!j.contains("transmittance")) Fail("transmittance: missing");
         if (!j.contains("scattering")) Fail("scattering: missing");
         w.transmittance =
@@ -224,6 +229,7 @@ std::string NeuralWeightsToJson(const NeuralWeights& w) {
     a["mie_extinction"] = v3(w.mie_extinction);
     a["absorption_extinction"] = v3(w.absorption_extinction);
     j["atmosphere"] = a;
+    if (w.has_fit_atmosphere) j["fit_atmosphere"] = json::parse(AtmosphereToJson(w.fit_atmosphere));
     j["transmittance"] = NetToJson(w.transmittance);
     j["scattering"] = NetToJson(w.scattering);
     j["training"] = json::parse(w.training_json);
@@ -247,18 +253,53 @@ NeuralWeights EmbeddedNeuralWeights(const std::string& name) {
 
 void CheckNeuralWeightsMatch(const NeuralWeights& w, const AtmosphereParameters& a,
                              const std::string& source) {
-    const bool ok = Close(w.bottom_radius, a.bottom_radius) && Close(w.top_radius, a.top_radius) &&
-                    Close(w.mie_phase_g, a.mie_phase_g) &&
-                    Close(w.rayleigh_scattering, a.rayleigh_scattering) &&
-                    Close(w.mie_scattering, a.mie_scattering) &&
-                    Close(w.mie_extinction, a.mie_extinction) &&
-                    Close(w.absorption_extinction, a.absorption_extinction);
-    if (!ok) {
-        Fail(
-            "neural weights ", source,
-            " were fitted to another atmosphere (radii, scattering or absorption differ); fit new "
-            "ones with `atmos fit --model neural --atmosphere ... -o FILE.json` and pass --weights "
-            "FILE.json");
+    const char* fix =
+        "; fit new ones with `atmos fit --model neural --atmosphere ... [--set ...] -o FILE.json` "
+        "and pass --weights FILE.json";
+    if (!w.has_fit_atmosphere) {
+        Fail("neural weights ", source,
+             " do not record the whole atmosphere they were fitted to (no \"fit_atmosphere\": "
+             "written before atmos checked ground albedo and density profiles)",
+             fix);
+    }
+    // Every field the fit depends on: the reference the networks were fitted
+    // to saw all of them (ground albedo through the ground's light in the
+    // higher orders, sun_angular_radius through the sun's disc at the horizon,
+    // mu_s_min through the precomputed tables); solar_irradiance only scales
+    // the output.
+    const AtmosphereParameters& f = w.fit_atmosphere;
+    std::string differ;
+    auto add = [&differ](const char* name) {
+        differ += (differ.empty() ? "" : ", ") + std::string(name);
+    };
+    auto same_profile = [](const DensityProfile& x, const DensityProfile& y) {
+        for (int l = 0; l < 2; ++l) {
+            const DensityProfileLayer& p = x.layers[l];
+            const DensityProfileLayer& q = y.layers[l];
+            if (!Close(p.width, q.width) || !Close(p.exp_term, q.exp_term) ||
+                !Close(p.exp_scale, q.exp_scale) || !Close(p.linear_term, q.linear_term) ||
+                !Close(p.constant_term, q.constant_term)) {
+                return false;
+            }
+        }
+        return true;
+    };
+    if (!Close(f.bottom_radius, a.bottom_radius)) add("bottom_radius");
+    if (!Close(f.top_radius, a.top_radius)) add("top_radius");
+    if (!Close(f.rayleigh_scattering, a.rayleigh_scattering)) add("rayleigh_scattering");
+    if (!same_profile(f.rayleigh_density, a.rayleigh_density)) add("rayleigh_density");
+    if (!Close(f.mie_scattering, a.mie_scattering)) add("mie_scattering");
+    if (!Close(f.mie_extinction, a.mie_extinction)) add("mie_extinction");
+    if (!same_profile(f.mie_density, a.mie_density)) add("mie_density");
+    if (!Close(f.mie_phase_g, a.mie_phase_g)) add("mie_phase_g");
+    if (!Close(f.absorption_extinction, a.absorption_extinction)) add("absorption_extinction");
+    if (!same_profile(f.absorption_density, a.absorption_density)) add("absorption_density");
+    if (!Close(f.ground_albedo, a.ground_albedo)) add("ground_albedo");
+    if (!Close(f.sun_angular_radius, a.sun_angular_radius)) add("sun_angular_radius");
+    if (!Close(f.mu_s_min, a.mu_s_min)) add("mu_s_min");
+    if (!differ.empty()) {
+        Fail("neural weights ", source, " were fitted to another atmosphere (", differ, " differ)",
+             fix);
     }
 }
 

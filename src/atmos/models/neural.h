@@ -131,6 +131,10 @@ struct NeuralWeights {
     double top_radius = 0.0;
     double mie_phase_g = 0.0;
     Vec3d rayleigh_scattering, mie_scattering, mie_extinction, absorption_extinction;
+    // The whole atmosphere of the fit (JSON "fit_atmosphere"; older files
+    // lack it and are refused by CheckNeuralWeightsMatch).
+    bool has_fit_atmosphere = false;
+    AtmosphereParameters fit_atmosphere;
     std::string training_json = "{}";  // free-form record of the fit (JSON object text)
 };
 
@@ -141,7 +145,10 @@ std::string NeuralWeightsToJson(const NeuralWeights& weights);
 NeuralWeights LoadNeuralWeights(const std::string& path);
 // The weights shipped in data/neural/<name>.json (embedded at build time).
 NeuralWeights EmbeddedNeuralWeights(const std::string& name);
-// Throws atmos::Error when `weights` were fitted to another atmosphere.
+// Throws atmos::Error when `weights` were fitted to another atmosphere: every
+// field the fit depends on (all but solar_irradiance: the networks give
+// radiance per unit solar irradiance) is compared, and the message names the
+// fields that differ and `atmos fit`.
 void CheckNeuralWeightsMatch(const NeuralWeights& weights, const AtmosphereParameters& atmosphere,
                              const std::string& source);
 NeuralEvaluator MakeNeuralEvaluator(const NeuralWeights& weights,

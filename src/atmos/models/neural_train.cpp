@@ -374,6 +374,8 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     w.mie_scattering = atm.mie_scattering;
     w.mie_extinction = atm.mie_extinction;
     w.absorption_extinction = atm.absorption_extinction;
+    w.has_fit_atmosphere = true;
+    w.fit_atmosphere = atm;
     nlohmann::json tj;
     tj["network"] = o.network;
     tj["transmittance_samples"] = o.transmittance_samples;
