@@ -8,6 +8,7 @@
 #include "atmos/model.h"
 #include "base/parallel.h"
 #include "cli_common.h"
+#include "io/output_path.h"
 
 namespace atmos::cli {
 
@@ -24,6 +25,7 @@ Command AddBakeCommand(CLI::App* root) {
         if (!model->CanBake()) Fail("model ", common->model, " has no precomputed tables to bake");
         ThreadLimit limit(common->threads);
         const AtmosphereParameters atmosphere = LoadAtmosphere(common->atmosphere, common->sets);
+        CheckOutputDirectory(*output);  // before the precomputation (io/output_path.h)
         const double seconds = PrepareModel(*common, atmosphere, model.get());
         std::filesystem::create_directories(*output);
         model->Bake(*output);
