@@ -66,21 +66,7 @@ Vec4f FormerGather(const TableView& prev, const AtmosphereParameters& atm, const
         out.mie = in.mie * AplusMiePhase(atm.mie_phase_g, c) * sin_t;
         return out;
     };
-    // Issue 18 item 4: the phase functions' quadrature renormalised to 4 pi.
-    const auto phase = [&](double theta, double phi) {
-        const double sin_t = std::sin(theta);
-        const double c = ClampCosine(sin_t * std::cos(phi) * sin_phi + std::cos(theta) * mu);
-        AplusValue out;
-        out.rayleigh = Vec3d(AplusRayleighPhase(c) * sin_t);
-        out.mie = AplusMiePhase(atm.mie_phase_g, c) * sin_t;
-        return out;
-    };
-    AplusValue sum = AplusTrapezoid2D<AplusValue>(f, 0.0, kPi, 0.0, 2.0 * kPi, n, s.gather_phi);
-    const AplusValue w =
-        AplusTrapezoid2D<AplusValue>(phase, 0.0, kPi, 0.0, 2.0 * kPi, n, s.gather_phi);
-    sum.rayleigh = sum.rayleigh * (4.0 * kPi / w.rayleigh.x);
-    sum.mie = sum.mie * (4.0 * kPi / w.mie);
-    return AplusToVec4f(sum);
+    return AplusToVec4f(AplusTrapezoid2D<AplusValue>(f, 0.0, kPi, 0.0, 2.0 * kPi, n, s.gather_phi));
 }
 
 // Both paths of the gather stage (incoming values kept in the local array, and

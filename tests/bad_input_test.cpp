@@ -39,12 +39,12 @@ std::string Slurp(const fs::path& p) {
     return ss.str();
 }
 
-struct Run {
+struct Outcome {
     int status = -1;
     std::string out, err;
 };
 
-Run Atmos(const fs::path& dir, const std::string& args, const std::string& input) {
+Outcome Atmos(const fs::path& dir, const std::string& args, const std::string& input) {
     static int counter = 0;
     const std::string id = std::to_string(++counter);
     const fs::path out = dir / ("out" + id), err = dir / ("err" + id), in = dir / ("in" + id);
@@ -52,7 +52,7 @@ Run Atmos(const fs::path& dir, const std::string& args, const std::string& input
     const std::string cmd = std::string(ATMOS_CLI_PATH) + " " + args + " < " + in.string() + " > " +
                             out.string() + " 2> " + err.string();
     const int raw = std::system(cmd.c_str());
-    Run r;
+    Outcome r;
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
     r.out = Slurp(out);
     r.err = Slurp(err);
@@ -173,7 +173,7 @@ TEST(BadInput, EveryCommandGivesOneLineAndExitTwo) {
     };
     const auto start = std::chrono::steady_clock::now();
     for (const Case& c : cases) {
-        const Run r = Atmos(dir, c.args, c.input);
+        const Outcome r = Atmos(dir, c.args, c.input);
         EXPECT_EQ(r.status, 2) << c.args << "\n" << r.err;
         EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << c.args << "\n" << r.err;
         EXPECT_EQ(r.err.rfind("atmos: error: ", 0), 0u) << c.args << "\n" << r.err;
@@ -197,7 +197,7 @@ TEST(BadInput, EveryCommandGivesOneLineAndExitTwo) {
 // Issue 18 item 8: numbers are read one way everywhere: a denormal is a number.
 TEST(BadInput, SampleReadsDenormals) {
     const fs::path dir = SweepDir();
-    const Run r = Atmos(dir, "sample --model flat", std::string(kHeader) + "1e-320,1,1,0\n");
+    const Outcome r = Atmos(dir, "sample --model flat", std::string(kHeader) + "1e-320,1,1,0\n");
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 2) << r.out;  // header + 1 row
     fs::remove_all(dir);

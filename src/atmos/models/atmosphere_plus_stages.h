@@ -172,7 +172,6 @@ struct AplusGatherStage {
         }
         const double sin_phi = SafeSqrt(1.0 - mu * mu);
         AplusValue sum;
-        double w_r = 0.0, w_m = 0.0;  // the same quadrature of the phase functions alone
         for (int k = 0; k <= m; ++k) {
             const double wy = (k == 0 || k == m) ? 1.0 : 2.0;
             const double phi = k * d_phi;
@@ -184,25 +183,13 @@ struct AplusGatherStage {
                 const double sin_t = sin(theta);
                 // cos of the scattering angle dot(-w, -V) = dot(w, V), V = (sin phi, 0, mu).
                 const double c = ClampCosine(sin_t * cos(phi) * sin_phi + cos(theta) * mu);
-                const double p_r = AplusRayleighPhase(c) * sin_t * (wx * wy);
-                const double p_m = AplusMiePhase(atm.mie_phase_g, c) * sin_t * (wx * wy);
                 AplusValue f;
-                f.rayleigh = in.rayleigh * p_r;
-                f.mie = in.mie * p_m;
-                sum += f;
-                w_r += p_r;
-                w_m += p_m;
+                f.rayleigh = in.rayleigh * (AplusRayleighPhase(c) * sin_t);
+                f.mie = in.mie * AplusMiePhase(atm.mie_phase_g, c) * sin_t;
+                sum += f * (wx * wy);
             }
         }
-        // The discrete phase functions renormalised to their exact integral,
-        // 4 pi (seed 000 1.7), so that the gather conserves energy (issue 18
-        // item 4): a peaked Mie lobe (g 0.9) on a 6 x 12 grid integrated to
-        // ~40 x 4 pi and each order gained that much (the orders diverged).
-        // For a resolved lobe the factors are 1 to the quadrature's accuracy.
-        AplusValue gathered;
-        gathered.rayleigh = sum.rayleigh * (w_r > 0.0 ? 4.0 * kPi / w_r : 0.0);
-        gathered.mie = sum.mie * (w_m > 0.0 ? 4.0 * kPi / w_m : 0.0);
-        out.Set(x, y, z, AplusToVec4f(gathered));
+        out.Set(x, y, z, AplusToVec4f(sum * (0.25 * d_theta * d_phi)));
     }
 };
 ATMOS_DEVICE_STAGE(AplusGatherStage)
