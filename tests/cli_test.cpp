@@ -397,8 +397,8 @@ TEST(Cli, SigintCheckpointsAndStops) {
         "render --model reference --view plane-dawn --size 8x4 -q "
         "--spp 1000000 --pass-spp 1 -o " +
         (dir / "i.exr").string();
-    const std::string cmd = "timeout -s INT 1 " + std::string(ATMOS_CLI_PATH) + " " + args +
-                            " > /dev/null 2> " + (dir / "err").string();
+    const std::string cmd = "timeout --preserve-status -s INT 1 " + std::string(ATMOS_CLI_PATH) +
+                            " " + args + " > /dev/null 2> " + (dir / "err").string();
     const int raw = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(raw));
     EXPECT_EQ(WEXITSTATUS(raw), 2);

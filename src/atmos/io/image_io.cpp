@@ -149,13 +149,26 @@ void CheckOutputFile(const std::string& path) {
 void CheckOutputDirectory(const std::string& path) {
     if (path.empty()) Fail("the output directory is empty");
     std::error_code ec;
-    if (std::filesystem::exists(path, ec) && !std::filesystem::is_directory(path, ec)) {
-        Fail("cannot write to directory '", path, "': it exists and is not a directory");
+    if (std::filesystem::exists(path, ec)) {
+        if (!std::filesystem::is_directory(path, ec)) {
+            Fail("cannot write to directory '", path, "': it exists and is not a directory");
+        }
+        const std::string why = ProbeWritable(path);
+        if (!why.empty()) Fail("cannot write to directory '", path, "': ", why);
+        return;
     }
-    std::filesystem::create_directories(path, ec);
-    if (ec) Fail("cannot create directory '", path, "': ", ec.message());
-    const std::string why = ProbeWritable(path);
-    if (!why.empty()) Fail("cannot write to directory '", path, "': ", why);
+    // Not there yet (the command creates it after its checks): the nearest
+    // existing ancestor must be a writable directory.
+    std::filesystem::path ancestor = std::filesystem::absolute(path, ec).parent_path();
+    while (!ancestor.empty() && !std::filesystem::exists(ancestor, ec)) {
+        if (ancestor == ancestor.parent_path()) break;
+        ancestor = ancestor.parent_path();
+    }
+    if (!std::filesystem::is_directory(ancestor, ec)) {
+        Fail("cannot create directory '", path, "': '", ancestor.string(), "' is not a directory");
+    }
+    const std::string why = ProbeWritable(ancestor);
+    if (!why.empty()) Fail("cannot create directory '", path, "': ", why);
 }
 
 Image ReadImage(const std::string& path) {

@@ -15,8 +15,9 @@ namespace atmos {
 // writable (a probe file is created and removed) and `path` is not a
 // directory. Throws atmos::Error naming the path and the reason.
 void CheckOutputFile(const std::string& path);
-// The directory `path` exists or can be created (it is created) and is
-// writable. Throws atmos::Error naming the path and the reason.
+// The directory `path` exists and is writable, or can be created (its nearest
+// existing ancestor is a writable directory; nothing is created here).
+// Throws atmos::Error naming the path and the reason.
 void CheckOutputDirectory(const std::string& path);
 
 }  // namespace atmos
