@@ -73,7 +73,6 @@ int CmdCompare(const CompareCliOptions& o) {
     const std::string cache =
         o.cache_flag->count() > 0 ? o.cache : (o.output.empty() ? o.cache : o.output + "/cache");
     config.cache_dir = o.no_cache ? "" : o.backend == "cuda" ? cache + "/cuda" : cache;
-    CheckOutputDirectory(config.output_dir);  // before the work (io/output_path.h)
     config.write_npy = !o.no_npy;
     config.show_progress = !o.quiet;
     CheckFlipPpd(o.ppd);
@@ -106,6 +105,7 @@ int CmdCompare(const CompareCliOptions& o) {
     }
     CreateModel(config.reference_model, config.reference_options);  // validate the options
 
+    CheckOutputDirectory(config.output_dir);  // after the flags, before the work (io/output_path.h)
     ThreadLimit limit(o.threads);
     const BackendScope backend(ParseBackend(o.backend));
     const CompareResult r = RunCompare(config);
