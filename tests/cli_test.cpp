@@ -392,7 +392,9 @@ TEST(Cli, CheckpointSurvivesAKillAtEveryWriteAndRename) {
     for (const auto& [call, when] : faults) {
         {
             fs::remove(dir / "ck.bin");
-            ASSERT_EQ(RunAtmos(base + "--spp 4 -o " + (dir / "half.exr").string()).status, 0);
+            ASSERT_EQ(RunAtmos(base + "--spp 4 --keep-checkpoint -o " + (dir / "half.exr").string())
+                          .status,
+                      0);
             const std::string inject = std::string("strace -f -o /dev/null -e trace=") + call +
                                        " -e inject=" + call +
                                        ":error=EIO:signal=SIGKILL:when=" + std::to_string(when) +
@@ -409,6 +411,56 @@ TEST(Cli, CheckpointSurvivesAKillAtEveryWriteAndRename) {
             EXPECT_TRUE(Slurp(dir / "resumed.exr") == want) << call << " " << when;
         }
     }
+}
+
+// Issue 18 item 10: the checkpoint is deleted once the image is written,
+// unless --keep-checkpoint.
+TEST(Cli, CheckpointDeletedAfterSuccessUnlessKept) {
+    const fs::path dir = TempDir() / "ckpt_delete";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string base = "render --model reference --view plane-dawn --size 8x4 -q --spp 2 ";
+    ASSERT_EQ(RunAtmos(base + "-o " + (dir / "a.exr").string()).status, 0);
+    EXPECT_TRUE(fs::exists(dir / "a.exr"));
+    EXPECT_FALSE(fs::exists(dir / "a.ckpt.bin"));
+    ASSERT_EQ(RunAtmos(base + "--keep-checkpoint -o " + (dir / "b.exr").string()).status, 0);
+    EXPECT_TRUE(fs::exists(dir / "b.ckpt.bin"));
+}
+
+// Issue 18 item 10: SIGINT during a checkpointed render finishes the pass,
+// writes the checkpoint and stops with one line saying how to resume.
+TEST(Cli, SigintCheckpointsAndStops) {
+    if (std::system("timeout --help > /dev/null 2>&1") != 0) GTEST_SKIP() << "no timeout(1)";
+    const fs::path dir = TempDir() / "sigint";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string args =
+        "render --model reference --view plane-dawn --size 8x4 -q "
+        "--spp 1000000 --pass-spp 1 -o " +
+        (dir / "i.exr").string();
+    const std::string cmd = "timeout --preserve-status -s INT 1 " + std::string(ATMOS_CLI_PATH) +
+                            " " + args + " > /dev/null 2> " + (dir / "err").string();
+    const int raw = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(raw));
+    EXPECT_EQ(WEXITSTATUS(raw), 2);
+    const std::string err = Slurp(dir / "err");
+    EXPECT_NE(err.find("atmos: error: interrupted by SIGINT after pass"), std::string::npos) << err;
+    EXPECT_NE(err.find("--resume"), std::string::npos) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_TRUE(fs::exists(dir / "i.ckpt.bin"));
+    EXPECT_FALSE(fs::exists(dir / "i.exr"));
+}
+
+// Issue 18 item 10: compare -o DIR keeps its render cache under DIR.
+TEST(Cli, CompareCachesUnderItsOutput) {
+    const fs::path dir = TempDir() / "compare_cache";
+    fs::remove_all(dir);
+    const Result r = RunAtmos(
+        "compare --models naive --reference flat --views ground-noon "
+        "--size 8x4 --quiet --no-npy -o " +
+        dir.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir / "cache")) << r.err;
 }
 
 }  // namespace

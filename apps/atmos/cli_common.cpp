@@ -5,6 +5,12 @@
 
 namespace atmos::cli {
 
+namespace {
+bool g_strict = false;
+}  // namespace
+
+bool StrictRequested() { return g_strict; }
+
 void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
     cmd->add_option("--model,-m", o->model,
                     "the model and its options: NAME[:OPTION=VALUE...], e.g. bruneton:orders=2 "
@@ -15,8 +21,11 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
     cmd->add_option("--set", o->sets, "override one atmosphere field: FIELD=VALUE (repeatable)")
         ->allow_extra_args(false);
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(CLI::Range(0, 4096));  // (NonNegativeNumber printed a 309-digit bound)
     cmd->add_flag("--quiet,-q", o->quiet, "no progress bar or timing lines");
+    cmd->add_flag("--strict", g_strict,
+                  "fail (exit 2) when the output guard had to replace a NaN, infinite or "
+                  "negative value by 0 (default: a warning)");
     cmd->add_option("--load", o->load,
                     "read the model's tables from a directory written by `atmos bake` instead of "
                     "precomputing them");
@@ -27,6 +36,15 @@ void AddBackendOption(CLI::App* cmd, std::string* backend) {
                     "where pixels are computed: cpu, or cuda (a build with -DATMOS_CUDA=ON and a "
                     "CUDA device)")
         ->capture_default_str();
+}
+
+void RequireQuantity(const ModelInfo& info, Quantity quantity) {
+    const bool produces = quantity == Quantity::kRadiance ? info.capabilities.radiance
+                                                          : info.capabilities.transmittance;
+    if (!produces) {
+        Fail("model ", info.name, " does not produce ", QuantityName(quantity), " (it produces ",
+             info.capabilities.radiance ? "radiance" : "transmittance", " only)");
+    }
 }
 
 ModelSpec GivenModel(const CommonOptions& o) { return ParseModelSpec(o.model); }

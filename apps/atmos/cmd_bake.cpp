@@ -14,6 +14,7 @@
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "embedded_assets.h"
+#include "io/output_path.h"
 
 namespace atmos::cli {
 
@@ -52,6 +53,7 @@ std::string BakeInto(const CommonOptions& common, const std::string& dir) {
     if (!model->CanBake()) Fail("model ", common.model, " has no precomputed tables to bake");
     ThreadLimit limit(common.threads);
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
+    CheckOutputDirectory(dir);  // before the precomputation (io/output_path.h)
     const double seconds = PrepareModel(common, atmosphere, model.get());
     fs::create_directories(dir);
     model->Bake(dir);
@@ -186,6 +188,7 @@ Command AddViewerCommand(CLI::App* root) {
             Fail("--load reads one model's tables: give one model in --models");
         }
         const fs::path dir(*output);
+        CheckOutputDirectory(dir.string());  // before any precomputation
         fs::create_directories(dir);
         std::string list;
         for (const std::string& spec : specs) {

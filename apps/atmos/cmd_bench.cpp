@@ -114,9 +114,14 @@ int CmdBench(const BenchOptions& o) {
     for (const std::string& m : o.models) models.push_back(ParseModelSpec(m));
     if (models.empty()) {
         for (const ModelInfo& info : ListModels()) {
-            if (!info.capabilities.stochastic) models.push_back(ParseModelSpec(info.name));
+            const bool produces = quantity == Quantity::kRadiance ? info.capabilities.radiance
+                                                                  : info.capabilities.transmittance;
+            if (!info.capabilities.stochastic && produces) {
+                models.push_back(ParseModelSpec(info.name));
+            }
         }
     }
+    for (const ModelSpec& m : models) RequireQuantity(GetModelInfo(m.name), quantity);
     bool any_monte_carlo = false;
     for (const ModelSpec& m : models) {
         any_monte_carlo = any_monte_carlo || GetModelInfo(m.name).capabilities.stochastic;
@@ -292,7 +297,7 @@ Command AddBenchCommand(CLI::App* root) {
     cmd->add_option("--set", o->sets, "override one atmosphere field: FIELD=VALUE (repeatable)")
         ->allow_extra_args(false);
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(CLI::Range(0, 4096));  // (NonNegativeNumber printed a 309-digit bound)
     cmd->add_option("-o,--output", o->output, "CSV file")->capture_default_str();
     AddMonteCarloFlags(cmd, &o->monte_carlo);
     Command c;

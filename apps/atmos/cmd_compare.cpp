@@ -14,6 +14,7 @@
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "harness/compare.h"
+#include "io/output_path.h"
 #include "render/progressive.h"
 
 namespace atmos::cli {
@@ -37,6 +38,7 @@ struct CompareCliOptions {
     std::string output;
     std::string cache = "out/cache";
     bool no_cache = false;
+    CLI::Option* cache_flag = nullptr;
     bool no_npy = false;
     bool quiet = false;
     int threads = 0;
@@ -68,7 +70,10 @@ int CmdCompare(const CompareCliOptions& o) {
                         : config.quantity == Quantity::kTransmittance ? "out/transmittance"
                                                                       : "out";
     // CUDA images may differ from CPU ones in the last bits: their own cache.
-    config.cache_dir = o.no_cache ? "" : o.backend == "cuda" ? o.cache + "/cuda" : o.cache;
+    // The cache lives under the output directory unless --cache names one.
+    const std::string cache =
+        o.cache_flag->count() > 0 ? o.cache : (o.output.empty() ? o.cache : o.output + "/cache");
+    config.cache_dir = o.no_cache ? "" : o.backend == "cuda" ? cache + "/cuda" : cache;
     config.write_npy = !o.no_npy;
     config.show_progress = !o.quiet;
     CheckFlipPpd(o.ppd);
@@ -102,6 +107,7 @@ int CmdCompare(const CompareCliOptions& o) {
     }
     CreateModel(config.reference_model, config.reference_options);  // validate the options
 
+    CheckOutputDirectory(config.output_dir);  // after the flags, before the work (io/output_path.h)
     ThreadLimit limit(o.threads);
     const BackendScope backend(ParseBackend(o.backend));
     const CompareResult r = RunCompare(config);
@@ -149,7 +155,9 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
         ->allow_extra_args(false);
     cmd->add_option("-o,--output", o->output,
                     "output directory (default out, or out/transmittance)");
-    cmd->add_option("--cache", o->cache, "render cache directory")->capture_default_str();
+    o->cache_flag = cmd->add_option("--cache", o->cache,
+                                    "render cache directory (default: out/cache, or DIR/cache "
+                                    "with -o DIR)");
     cmd->add_flag("--no-cache", o->no_cache, "render everything, read and write no cache");
     cmd->add_flag("--no-npy", o->no_npy, "do not write .npy images");
     cmd->add_option("--ppd", o->ppd, "FLIP pixels per degree (default 67.0206)");
@@ -160,7 +168,7 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
                     "thesis (seed 003 section 11.5: 1e-9 added to every pixel)")
         ->capture_default_str();
     cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(CLI::Range(0, 4096));  // (NonNegativeNumber printed a 309-digit bound)
     cmd->add_flag("--quiet,-q", o->quiet, "no progress lines");
     AddBackendOption(cmd, &o->backend);
     Command c;

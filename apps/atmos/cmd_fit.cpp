@@ -13,6 +13,7 @@
 #include "atmos/model.h"
 #include "base/parallel.h"
 #include "cli_common.h"
+#include "io/output_path.h"
 #include "models/neural_train.h"
 #include "render/progressive.h"
 
@@ -36,11 +37,21 @@ int CmdFit(const FitOptions& o) {
     if (o.model != "neural") Fail("fit: only --model neural can be fitted, got '", o.model, "'");
     if (o.reference == o.model) Fail("fit: --reference cannot be the model being fitted");
     if (o.output.empty()) Fail("fit: -o FILE.json is required");
+    CheckOutputFile(o.output);  // before the fit (io/output_path.h)
     ThreadLimit limit(o.threads);
     const AtmosphereParameters atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
     const ModelSpec spec = ParseModelSpec(o.reference);
     if (spec.name == o.model) Fail("fit: --reference cannot be the model being fitted");
     std::unique_ptr<Model> reference = CreateModel(spec);
+    // The fit learns radiance and transmittance everywhere (ground to space, sun
+    // below the horizon): a reference without them would train on nonsense.
+    const ModelCapabilities& rc = reference->Info().capabilities;
+    if (!rc.radiance || !rc.transmittance || !rc.space_views || !rc.sun_below_horizon) {
+        Fail("fit: --reference ", spec.name,
+             " cannot be a reference (it needs radiance and transmittance for every camera and "
+             "sun; `atmos list ",
+             spec.name, "` shows its validity)");
+    }
     NeuralFitOptions fit = o.fit;
     fit.reference_monte_carlo = MakeMonteCarloSettings(o.reference_spp, 0, 0, "--reference-spp");
     const auto t0 = std::chrono::steady_clock::now();

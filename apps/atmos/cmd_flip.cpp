@@ -7,6 +7,7 @@
 #include "atmos/error.h"
 #include "atmos/image.h"
 #include "cli_common.h"
+#include "io/output_path.h"
 #include "metrics/flip.h"
 
 namespace atmos::cli {
@@ -33,7 +34,10 @@ int CmdFlip(const FlipCliOptions& o) {
     options.has_stop_exposure = o.stop_flag->count() > 0;
     options.stop_exposure = o.stop;
     options.num_exposures = o.exposures;
-    if (!o.output.empty()) ImageFormatFromPath(o.output);  // fail early on a bad extension
+    if (!o.output.empty()) {
+        ImageFormatFromPath(o.output);  // fail early on a bad extension
+        CheckOutputFile(o.output);      // and on an unwritable path (io/output_path.h)
+    }
     bool hdr = false;
     if (o.mode == "auto") {
         hdr = ImageFormatFromPath(o.reference) != ImageFormat::kPng;
@@ -90,7 +94,7 @@ Command AddFlipCommand(CLI::App* root) {
     o->start_flag = cmd->add_option("--start-exposure", o->start, "HDR start exposure (log2)");
     o->stop_flag = cmd->add_option("--stop-exposure", o->stop, "HDR stop exposure (log2)");
     cmd->add_option("--num-exposures", o->exposures, "HDR number of exposures")
-        ->check(CLI::NonNegativeNumber);
+        ->check(CLI::Range(0, 1000));
     Command c;
     c.app = cmd;
     c.run = [o] { return CmdFlip(*o); };

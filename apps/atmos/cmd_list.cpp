@@ -36,6 +36,16 @@ void PrintCapabilities(const ModelInfo& info) {
         c.transmittance ? "transmittance" : "", c.space_views ? "yes" : "no",
         c.sun_below_horizon ? "yes" : "no", c.multiple_scattering ? "yes" : "no",
         c.precomputed ? "; precomputed" : "", c.stochastic ? "; Monte Carlo" : "");
+    // Issue 18 item 4: the models whose precomputation checks that its
+    // scattering orders decrease (models/order_check.h).
+    if (info.name == "bruneton" || info.name == "atmosphere-plus") {
+        std::printf(
+            "  %-16s   validity: optically thick or strongly forward-scattering atmospheres can be "
+            "past "
+            "the method's limit: Prepare warns on stderr when a precomputed scattering order stops "
+            "decreasing, and the radiance is then not valid\n",
+            "");
+    }
 }
 
 // `atmos list NAME`: one model with its option table (its own defaults).

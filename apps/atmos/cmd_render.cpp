@@ -21,6 +21,7 @@
 #include "cli_common.h"
 #include "cli_monte_carlo.h"
 #include "harness/gallery.h"
+#include "io/output_path.h"
 
 namespace fs = std::filesystem;
 
@@ -37,6 +38,7 @@ struct RenderOptions {
     float exposure = 0.0f;   // 0: the view's
     std::string checkpoint;  // Monte Carlo models: checkpoint stem (default: OUTPUT.ckpt)
     bool resume = false;
+    bool keep_checkpoint = false;
     MonteCarloFlags monte_carlo;
 };
 
@@ -47,6 +49,12 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     if (ro.output.empty()) Fail("render needs an output: -o FILE (or -o DIR with --view all)");
     const bool all_views = ro.view == "all";
     if (!all_views) ImageFormatFromPath(ro.output);  // fail before the work on a bad name
+    // The output is writable before any work (io/output_path.h).
+    if (all_views) {
+        CheckOutputDirectory(ro.output);
+    } else {
+        CheckOutputFile(ro.output);
+    }
     if (!std::isfinite(ro.exposure) || ro.exposure < 0.0f) {
         Fail("--exposure must be a positive number");
     }
@@ -55,6 +63,7 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     const BackendScope backend(ParseBackend(common.backend));
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(GivenModel(common));
+    RequireQuantity(model->Info(), quantity);
     const MonteCarloSettings monte_carlo = ro.monte_carlo.Settings(model->Info());
     std::vector<View> views;
     if (all_views) {
@@ -109,6 +118,11 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
             WriteImage(image, ro.output, exposure);
         }
         if (!variance.empty()) WriteImage(variance, out_stem + ".variance.exr");
+        // The image is written: its checkpoint has done its job (issue 18 item 10).
+        if (!request.checkpoint.empty() && !ro.keep_checkpoint) {
+            std::error_code ignored;
+            fs::remove(request.checkpoint + ".bin", ignored);
+        }
         if (!common.quiet) {
             std::fprintf(stderr, "rendered %-22s %dx%d with %s in %.3f s (%d threads)\n",
                          view.name.c_str(), width, height, common.model.c_str(), seconds,
@@ -149,6 +163,10 @@ Command AddRenderCommand(CLI::App* root) {
     render->add_option("--checkpoint", ro->checkpoint,
                        "Monte Carlo models: checkpoint file stem (default: OUTPUT without its "
                        "extension + .ckpt); checkpoints hold the sums and the sample count");
+    render->add_flag("--keep-checkpoint", ro->keep_checkpoint,
+                     "Monte Carlo models: keep the checkpoint after the image is written (to "
+                     "extend the render later with a larger --spp and --resume); by default it "
+                     "is deleted");
     render->add_flag("--resume", ro->resume,
                      "Monte Carlo models: continue from the checkpoint of the same render");
     AddMonteCarloFlags(render, &ro->monte_carlo);

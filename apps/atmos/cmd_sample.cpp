@@ -16,6 +16,7 @@
 #include "atmos/error.h"
 #include "atmos/image.h"
 #include "atmos/model.h"
+#include "atmos/number.h"
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "cli_common.h"
@@ -31,13 +32,10 @@ namespace {
 
 // Parses one CSV field as a finite number.
 double ParseField(const std::string& text, int line, const char* column) {
-    errno = 0;
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    const bool ok = !text.empty() && errno == 0 && end == text.c_str() + text.size();
-    if (!ok || !std::isfinite(v)) {
-        Fail("line ", line, ": ", column, " '", text, "' is not a finite number");
-    }
+    double v = 0.0;
+    const NumberError e = ParseNumber(text, &v);  // atmos/number.h: the one parser
+    if (e != NumberError::kNone)
+        Fail("line ", line, ": ", column, " '", text, "' ", NumberErrorText(e));
     return v;
 }
 

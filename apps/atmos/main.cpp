@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -39,7 +40,19 @@ int main(int argc, char** argv) {
         }
         app.parse(argc, argv);
         for (const Command& c : commands) {
-            if (c.app->parsed()) return c.run();
+            if (!c.app->parsed()) continue;
+            const int status = c.run();
+            const int64_t guarded = atmos::OutputGuardCount();
+            if (guarded > 0) {
+                const bool strict = StrictRequested();
+                std::fprintf(stderr,
+                             "atmos: %s: %lld output value(s) were NaN, infinite or negative and "
+                             "were written as 0 (a defect: please report it with the command "
+                             "line)\n",
+                             strict ? "error" : "warning", static_cast<long long>(guarded));
+                if (strict) return 2;
+            }
+            return status;
         }
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
@@ -76,8 +89,24 @@ int main(int argc, char** argv) {
     } catch (const atmos::Error& e) {
         std::fprintf(stderr, "atmos: error: %s\n", e.what());
         return 2;
+    } catch (const std::filesystem::filesystem_error& e) {
+        // A file system failure is an input error (a missing or unwritable
+        // path): one line naming the path, not the library's raw text.
+        std::string paths = e.path1().string();
+        if (!e.path2().empty()) paths += "' -> '" + e.path2().string();
+        std::fprintf(stderr, "atmos: error: '%s': %s\n", paths.c_str(), e.code().message().c_str());
+        return 2;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "atmos: error: %s\n", e.what());
+        const std::string what = e.what();
+        // A JSON library exception that escaped a parser: malformed input.
+        const std::string json_tag = "[json.exception.";
+        if (what.rfind(json_tag, 0) == 0) {
+            const size_t end = what.find("] ");
+            std::fprintf(stderr, "atmos: error: invalid JSON: %s\n",
+                         end == std::string::npos ? what.c_str() : what.c_str() + end + 2);
+            return 2;
+        }
+        std::fprintf(stderr, "atmos: error: %s\n", what.c_str());
         return 1;
     }
     return 0;

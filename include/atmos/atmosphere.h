@@ -62,6 +62,14 @@ AtmosphereParameters EarthAtmosphere();
 // allowed range.
 void ValidateAtmosphere(const AtmosphereParameters& atmosphere);
 
+// The radius above which the atmosphere's vertical column has an optical depth
+// below `column_depth` (per channel, at most top_radius): models that step
+// uniformly along a ray integrate up to it, so that their steps follow the
+// density where the atmosphere is much thicker than its scale heights (a giant
+// planet: 16 steps over 10^9 m would miss an 8 km scale height). For the
+// presets it is top_radius.
+double EffectiveTopRadius(const AtmosphereParameters& atmosphere, double column_depth = 1e-9);
+
 // Names of the presets shipped in data/atmospheres (without ".json").
 std::vector<std::string> AtmospherePresetNames();
 

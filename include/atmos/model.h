@@ -151,6 +151,13 @@ class Model {
     virtual void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere);
 };
 
+// Output values (NaN, infinity or negative) that the last guard of every render
+// and sample (and of the progressive mean) replaced by 0 since the process
+// started or the last reset (issue 18 item 3). Non-zero means some answer was
+// wrong: the CLI warns on stderr, and fails with --strict.
+int64_t OutputGuardCount();
+void ResetOutputGuardCount(int64_t value = 0);  // tests: restore a count
+
 // All registered models, in the registry's order (src/atmos/models/registry.cpp).
 std::vector<ModelInfo> ListModels();
 const ModelInfo& GetModelInfo(const std::string& name);  // throws for an unknown name

@@ -244,8 +244,35 @@ AtmosphereParameters ReadTree(const Json& root, const std::string& where) {
 }
 
 Json ParseText(const std::string& text, const std::string& source_name) {
+    // Duplicate keys are errors (JSON parsers keep either; a typo'd copy would
+    // silently win): the parser's callback sees each key, a stack holds the
+    // keys of the objects being read.
+    std::vector<std::vector<std::string>> keys;
+    std::string duplicate;
+    auto callback = [&](int depth, nlohmann::json::parse_event_t event, Json& parsed) {
+        (void)depth;
+        using Event = nlohmann::json::parse_event_t;
+        if (event == Event::object_start) {
+            keys.emplace_back();
+        } else if (event == Event::object_end) {
+            if (!keys.empty()) keys.pop_back();
+        } else if (event == Event::key && !keys.empty()) {
+            const std::string key = parsed.get<std::string>();
+            std::vector<std::string>& seen = keys.back();
+            if (duplicate.empty() && std::find(seen.begin(), seen.end(), key) != seen.end()) {
+                duplicate = key;
+            }
+            seen.push_back(key);
+        }
+        return true;
+    };
     try {
-        return Json::parse(text);
+        Json root = Json::parse(text, callback);
+        if (!duplicate.empty()) {
+            Fail("atmosphere '", source_name, "': the key \"", duplicate,
+                 "\" appears twice in one object (each field once)");
+        }
+        return root;
     } catch (const nlohmann::json::parse_error& e) {
         Fail("atmosphere '", source_name, "': JSON syntax error: ", JsonMessage(e));
     }
@@ -492,6 +519,13 @@ AtmosphereParameters LoadAtmosphere(const std::string& name_or_path,
         const std::streamoff size = in.tellg();
         in.seekg(0, std::ios::beg);
         if (size < 0) Fail("atmosphere '", name_or_path, "': cannot read the file");
+        // An atmosphere is a few hundred bytes; a huge file is a mistake (a
+        // 100 MiB file took 6 s and 520 MB to refuse).
+        constexpr std::streamoff kMaxBytes = 1 << 20;
+        if (size > kMaxBytes) {
+            Fail("atmosphere '", name_or_path, "': the file is ", size,
+                 " bytes, more than the 1 MiB an atmosphere file may have");
+        }
         text.resize(static_cast<size_t>(size));
         if (!in.read(text.data(), size)) {
             Fail("atmosphere '", name_or_path, "': cannot read the file");

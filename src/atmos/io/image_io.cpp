@@ -10,6 +10,10 @@
 #include "atmos/error.h"
 #include "atmos/image.h"
 #include "io/image_formats.h"
+#include "io/output_path.h"
+
+#include <fcntl.h>
+#include <unistd.h>
 
 namespace atmos {
 
@@ -65,21 +69,106 @@ void WriteImage(const Image& image, const std::string& path, float exposure) {
         Fail("cannot write '", path, "': the image holds ", image.size(), " floats, expected ",
              image.width(), "x", image.height(), "x3");
     }
-    switch (format) {
-        case ImageFormat::kExr:
-            detail::WriteExr(image, path);
-            return;
-        case ImageFormat::kPng:
-            detail::WritePng(image, path, exposure);
-            return;
-        case ImageFormat::kNpy:
-            detail::WriteNpy(image, path);
-            return;
-        case ImageFormat::kPfm:
-            detail::WritePfm(image, path);
-            return;
+    if (std::filesystem::is_directory(path)) Fail("cannot write '", path, "': it is a directory");
+    // Every format through a temporary file beside the target and one rename:
+    // a failed write (a full disk) leaves no truncated file under `path`.
+    const std::filesystem::path target(path);
+    const std::string temporary =
+        (target.parent_path() /
+         ("." + target.filename().string() + ".tmp-" +
+          std::to_string(static_cast<long>(::getpid())) + target.extension().string()))
+            .string();
+    try {
+        switch (format) {
+            case ImageFormat::kExr:
+                detail::WriteExr(image, temporary);
+                break;
+            case ImageFormat::kPng:
+                detail::WritePng(image, temporary, exposure);
+                break;
+            case ImageFormat::kNpy:
+                detail::WriteNpy(image, temporary);
+                break;
+            case ImageFormat::kPfm:
+                detail::WritePfm(image, temporary);
+                break;
+        }
+        std::error_code ec;
+        std::filesystem::rename(temporary, target, ec);
+        if (ec) Fail("cannot write '", path, "': ", ec.message());
+    } catch (const Error& e) {
+        std::error_code ignored;
+        std::filesystem::remove(temporary, ignored);
+        // The writers name the temporary file: name the target instead.
+        std::string message = e.what();
+        for (size_t at = message.find(temporary); at != std::string::npos;
+             at = message.find(temporary, at + path.size())) {
+            message.replace(at, temporary.size(), path);
+        }
+        throw Error(message);
+    } catch (...) {
+        std::error_code ignored;
+        std::filesystem::remove(temporary, ignored);
+        throw;
     }
-    Fail("cannot write '", path, "': unsupported image format");
+}
+
+namespace {
+
+// Creates and removes a probe file in `directory`; the errno text on failure.
+std::string ProbeWritable(const std::filesystem::path& directory) {
+    const std::string probe =
+        (directory / (".atmos-write-probe-" + std::to_string(static_cast<long>(::getpid()))))
+            .string();
+    errno = 0;
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0) return std::strerror(errno);
+    ::close(fd);
+    ::unlink(probe.c_str());
+    return "";
+}
+
+}  // namespace
+
+void CheckOutputFile(const std::string& path) {
+    if (path.empty()) Fail("the output path is empty");
+    const std::filesystem::path p(path);
+    std::error_code ec;
+    if (std::filesystem::is_directory(p, ec)) Fail("cannot write '", path, "': it is a directory");
+    const std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : ".";
+    if (!std::filesystem::exists(dir, ec)) {
+        Fail("cannot write '", path, "': the directory '", dir.string(), "' does not exist");
+    }
+    if (!std::filesystem::is_directory(dir, ec)) {
+        Fail("cannot write '", path, "': '", dir.string(), "' is not a directory");
+    }
+    const std::string why = ProbeWritable(dir);
+    if (!why.empty()) Fail("cannot write '", path, "': ", why);
+}
+
+void CheckOutputDirectory(const std::string& path) {
+    if (path.empty()) Fail("the output directory is empty");
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec)) {
+        if (!std::filesystem::is_directory(path, ec)) {
+            Fail("cannot write to directory '", path, "': it exists and is not a directory");
+        }
+        const std::string why = ProbeWritable(path);
+        if (!why.empty()) Fail("cannot write to directory '", path, "': ", why);
+        return;
+    }
+    // Not there yet (the command creates it after its checks): the nearest
+    // existing ancestor must be a writable directory.
+    std::filesystem::path ancestor = std::filesystem::absolute(path, ec).parent_path();
+    while (!ancestor.empty() && !std::filesystem::exists(ancestor, ec)) {
+        if (ancestor == ancestor.parent_path()) break;
+        ancestor = ancestor.parent_path();
+    }
+    if (!std::filesystem::is_directory(ancestor, ec)) {
+        Fail("cannot create directory '", path, "': '", ancestor.string(), "' is not a directory");
+    }
+    const std::string why = ProbeWritable(ancestor);
+    if (!why.empty()) Fail("cannot create directory '", path, "': ", why);
 }
 
 Image ReadImage(const std::string& path) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "atmos/error.h"
+#include "atmos/number.h"
 #include "io/image_formats.h"
 
 namespace atmos::detail {
@@ -83,9 +84,8 @@ Image ReadPfm(const std::string& path) {
     const int width = ParseDimension(NextToken(bytes, &pos, path), path, "width");
     const int height = ParseDimension(NextToken(bytes, &pos, path), path, "height");
     const std::string scale_token = NextToken(bytes, &pos, path);
-    char* end = nullptr;
-    const double scale = std::strtod(scale_token.c_str(), &end);
-    if (end != scale_token.c_str() + scale_token.size() || !std::isfinite(scale) || scale == 0.0) {
+    double scale = 0.0;
+    if (ParseNumber(scale_token, &scale) != NumberError::kNone || scale == 0.0) {
         Fail("cannot read PFM '", path, "': invalid scale '", scale_token, "'");
     }
     const bool little_endian = scale < 0.0;

@@ -1,5 +1,6 @@
 // atmos model `atmosphere-plus`: precomputation and options (see atmosphere_plus.h).
 #include "models/atmosphere_plus.h"
+#include "models/order_check.h"
 
 #include <chrono>
 #include <cmath>
@@ -62,6 +63,10 @@ AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings
     if (keep_orders) out.orders.push_back(order);
 
     // Orders 2..K (seed 000 2.2): gather from order k-1, order k, add to the sum.
+    // Each order's sum is recorded: orders that stop decreasing are reported
+    // (models/order_check.h; orders >= 2 share their units).
+    ScatteringOrders sums;
+    sums.Add(1, TableSum(order));
     for (int k = 2; k <= s.orders; ++k) {
         start = std::chrono::steady_clock::now();
         Table gather(s.width, s.height, s.depth, 4);
@@ -73,12 +78,12 @@ AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings
         RunStage("atmosphere-plus/sum", count, 4096,
                  AplusAddStage{next.view(), out.scattering.out(true)});
         order = std::move(next);
-        if (keep_orders) {
-            session.Download(&order);
-            out.orders.push_back(order);
-        }
+        session.Download(&order);
+        sums.Add(k, TableSum(order));
+        if (keep_orders) out.orders.push_back(order);
         out.order_seconds.push_back(SecondsSince(start));
     }
+    sums.WarnIfDiverging("atmosphere-plus", 3);
     session.Download(&out.transmittance);
     session.Download(&out.scattering);
     return out;

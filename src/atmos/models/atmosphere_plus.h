@@ -260,7 +260,17 @@ struct AtmospherePlusEvaluator {
                                 bool want_ground) const {
         RayResult out;
         AtmosphereSegment seg;
-        if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) return out;
+        if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) {
+            // A camera on the ground looking down (physics/ray.h): the ground at the camera.
+            if (want_ground && GroundAtCamera(seg) && MaxComponent(atm.ground_albedo) > 0.0) {
+                const double cos_sun = Dot(Normalize(camera), sun);
+                if (cos_sun > 0.0) {
+                    out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi)) *
+                                 AplusSampleTransmittance(transmittance, mapping, 0.0, cos_sun);
+                }
+            }
+            return out;
+        }
         // Seed 000 2.4: P_0 is the camera, or where the ray enters the atmosphere.
         const Vec3d p0 = camera + dir * seg.t_start;
         const double r = Length(p0);

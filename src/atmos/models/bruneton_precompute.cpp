@@ -13,6 +13,7 @@
 #include "base/parallel.h"
 #include "models/bruneton.h"
 #include "models/bruneton_stages.h"
+#include "models/order_check.h"
 #include "render/stages.h"
 
 namespace atmos {
@@ -20,7 +21,6 @@ namespace atmos {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
 
 // Rows of the 3D scattering table: one (mu, r) pair = (y, z), NU * MU_S texels.
 int RowCount(const BrunetonConfig& c) { return c.scattering_mu * c.scattering_r; }
@@ -230,6 +230,9 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
 
     const Table directions = MakeBrunetonDirectionTable();
     Table incident, delta_multiple, delta_density;
+    // Each order's multiple scattering is summed: orders that stop decreasing
+    // are reported (models/order_check.h; orders >= 2 share their units).
+    ScatteringOrders sums;
     for (int order = 2; order <= config.orders; ++order) {
         // 1. Incident radiance per (r, mu_s, direction); 2. per texel, its
         // phase-weighted sums in the sun's frame.
@@ -281,6 +284,8 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
         } else {
             ComputeBrunetonMultipleScatteringRows(lut, delta_density.view(), &delta_multiple);
         }
+        session.Download(&delta_multiple);
+        sums.Add(order, TableSum(delta_multiple));
         // Accumulate, divided by the Rayleigh phase function (the renderer
         // multiplies the whole table by it; seed 004 "Rendering").
         RunStage(
@@ -292,6 +297,7 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
         }
     }
     download(nullptr);
+    sums.WarnIfDiverging("bruneton", 3);
 }
 
 }  // namespace atmos

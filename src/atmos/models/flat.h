@@ -102,7 +102,12 @@ struct FlatEvaluator {
         const AnalyticMedia& m = optics.m;
         RayResult out;
         AtmosphereSegment seg;
-        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) return out;
+        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) {
+            // A camera on the ground looking down (physics/ray.h): the ground at the camera.
+            if (want_ground && GroundAtCamera(seg))
+                out.ground = optics.Ground(camera, sun, Vec3d(1.0));
+            return out;
+        }
         const MediaLengths l = optics.SegmentLengths(camera, dir, seg.t_start, seg.t_end);
         const Vec3d tau = m.Extinction(l.rayleigh, l.mie, l.ozone);
         const Vec3d p0 = camera + dir * seg.t_start;

@@ -377,7 +377,13 @@ struct HillaireEvaluator {
                                 bool want_ground) const {
         RayResult out;
         AtmosphereSegment seg;
-        if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) return out;
+        if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) {
+            // A camera on the ground looking down (physics/ray.h): the ground at the camera.
+            if (want_ground && GroundAtCamera(seg) && MaxComponent(atm.ground_albedo) > 0.0) {
+                out.ground = Rgb(GroundReflection(camera, sun));
+            }
+            return out;
+        }
         const double r = Length(camera);
         Vec3d L, T(1.0);
         if (sky_view.data != nullptr && r <= atm.top_radius) {

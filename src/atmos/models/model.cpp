@@ -7,6 +7,7 @@
 
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "atmos/number.h"
 
 namespace atmos {
 
@@ -99,11 +100,7 @@ std::string OptionsMarkdown(const std::vector<ModelOptionSpec>& specs) {
 namespace {
 
 bool ParseDouble(const std::string& text, double* value) {
-    if (text.empty()) return false;
-    errno = 0;
-    char* end = nullptr;
-    *value = std::strtod(text.c_str(), &end);
-    return errno == 0 && end == text.c_str() + text.size() && std::isfinite(*value);
+    return ParseNumber(text, value) == NumberError::kNone;  // atmos/number.h
 }
 
 [[noreturn]] void FailValue(const std::string& model, const ModelOptionSpec& spec,

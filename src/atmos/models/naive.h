@@ -84,7 +84,14 @@ class NaiveModel : public SimpleEvaluatorModel<NaiveModel, NaiveEvaluator> {
     static const OptionTable<NaiveOptions>& OptionRows();
     explicit NaiveModel(const NaiveOptions& options);
     static ModelInfo StaticInfo();
-    void Prepare(const AtmosphereParameters& atmosphere) override { SetAtmosphere(atmosphere); }
+    // The evaluator's shell ends at EffectiveTopRadius (atmos/atmosphere.h):
+    // the uniform steps then follow the density even where the atmosphere is
+    // far thicker than its scale heights (issue 18 item 3).
+    void Prepare(const AtmosphereParameters& atmosphere) override {
+        AtmosphereParameters clipped = atmosphere;
+        clipped.top_radius = EffectiveTopRadius(atmosphere);
+        SetAtmosphere(clipped);
+    }
 };
 
 }  // namespace atmos

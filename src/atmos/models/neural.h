@@ -75,7 +75,18 @@ struct NeuralEvaluator {
                                 bool want_ground) const {
         RayResult out;
         AtmosphereSegment seg;
-        if (!BeginRay(camera, dir, bottom, top, &out, &seg)) return out;
+        if (!BeginRay(camera, dir, bottom, top, &out, &seg)) {
+            // A camera on the ground looking down (physics/ray.h): the ground at the camera.
+            const double mu_s_g = ClampCosine(Dot(Normalize(camera), sun));
+            if (want_ground && GroundAtCamera(seg) && mu_s_g > 0.0) {
+                const float k = static_cast<float>(mu_s_g / kPi);
+                out.ground =
+                    Rgb(static_cast<float>(ground_albedo.x), static_cast<float>(ground_albedo.y),
+                        static_cast<float>(ground_albedo.z)) *
+                    Transmittance(bottom, mu_s_g) * k;
+            }
+            return out;
+        }
         // Viewer moved to the atmosphere's boundary (seed 003 section 9.6.3).
         Vec3d p = camera + dir * seg.t_start;
         double r = Length(p);

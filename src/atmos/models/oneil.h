@@ -106,7 +106,17 @@ struct OneilEvaluator {
         const AnalyticMedia& m = optics.m;
         RayResult out;
         AtmosphereSegment seg;
-        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) return out;
+        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) {
+            // A camera on the ground looking down (physics/ray.h): the ground at the camera.
+            if (want_ground && GroundAtCamera(seg) && MaxComponent(m.ground_albedo) > 0.0) {
+                const double cos_sun = Dot(Normalize(camera), sun);
+                if (cos_sun > 0.0) {
+                    out.ground = Rgb(m.ground_albedo * (cos_sun / kPi) *
+                                     Exp(-optics.LightDepth(camera, sun)));
+                }
+            }
+            return out;
+        }
         const double ds = (seg.t_end - seg.t_start) / steps;
         Vec3d sum_r, sum_m;
         for (int i = 0; i < steps; ++i) {

@@ -37,7 +37,12 @@ struct RaymarchedEvaluator {
         const AnalyticMedia& m = optics.m;
         RayResult out;
         AtmosphereSegment seg;
-        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) return out;
+        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) {
+            // A camera on the ground looking down (physics/ray.h): the ground at the camera.
+            if (want_ground && GroundAtCamera(seg))
+                out.ground = optics.Ground(camera, sun, Vec3d(1.0));
+            return out;
+        }
         const double dt = (seg.t_end - seg.t_start) / steps;
         Vec3d tau_view;  // camera to the start of the current part
         Vec3d light_a = optics.LightDepth(camera + dir * seg.t_start, sun);

@@ -11,6 +11,7 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/error.h"
+#include "physics/density.h"
 
 namespace atmos {
 
@@ -93,6 +94,28 @@ DensityProfile ExponentialProfile(double scale_height) {
     return profile;
 }
 
+double EffectiveTopRadius(const AtmosphereParameters& a, double column_depth) {
+    const double thickness = a.top_radius - a.bottom_radius;
+    if (!(thickness > 1.0)) return a.top_radius;
+    // Altitudes 0 and a geometric grid from 1 m to the top (ratio ~1.005), the
+    // column above each by the trapezoid rule from the top down.
+    constexpr int kPoints = 4096;
+    const double ratio = std::pow(thickness, 1.0 / (kPoints - 1));
+    auto extinction_at = [&](double h) { return MaxComponent(Extinction(a, GetDensities(a, h))); };
+    double h_above = thickness;
+    double e_above = extinction_at(h_above);
+    double column = 0.0;
+    for (int k = kPoints - 2; k >= -1; --k) {
+        const double h = k >= 0 ? std::pow(ratio, k) : 0.0;
+        const double e = extinction_at(h);
+        column += 0.5 * (e + e_above) * (h_above - h);
+        if (column >= column_depth) return a.bottom_radius + h_above;
+        h_above = h;
+        e_above = e;
+    }
+    return a.top_radius;  // (almost) no air at all: keep the shell
+}
+
 AtmosphereParameters EarthAtmosphere() {
     AtmosphereParameters a;
     // Seed 000 section 1.4 (Hillaire 2020): R_p and R_a.
@@ -148,8 +171,10 @@ void ValidateAtmosphere(const AtmosphereParameters& a) {
     CheckRange("sun_angular_radius", a.sun_angular_radius, 0.0, true, 0.5, false, "(0, 0.5] (rad)");
     for (int c = 0; c < 3; ++c) {
         const double value = a.solar_irradiance[c];
-        if (!std::isfinite(value) || value < 0.0) {
-            FailField(ChannelName("solar_irradiance", c), value, "[0, +inf)");
+        // Bounded so that radiance x irradiance stays finite in float (1e308
+        // overflowed to infinity, written as black).
+        if (!std::isfinite(value) || value < 0.0 || value > 1e9) {
+            FailField(ChannelName("solar_irradiance", c), value, "[0, 1e+09]");
         }
     }
     CheckRange("mu_s_min", a.mu_s_min, -1.0, false, 1.0, false, "[-1, 1]");

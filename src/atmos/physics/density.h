@@ -11,8 +11,10 @@
 namespace atmos {
 
 ATMOS_HD inline double GetLayerDensity(const DensityProfileLayer& layer, double altitude) {
-    const double density = layer.exp_term * Exp(layer.exp_scale * altitude) +
-                           layer.linear_term * altitude + layer.constant_term;
+    // A layer without its exponential term (exp_term 0) has none: 0 x exp(h)
+    // would be 0 x inf = NaN where exp(h) overflows (issue 18 item 3).
+    const double e = layer.exp_term != 0.0 ? layer.exp_term * Exp(layer.exp_scale * altitude) : 0.0;
+    const double density = e + layer.linear_term * altitude + layer.constant_term;
     return Clamp(density, 0.0, 1.0);
 }
 

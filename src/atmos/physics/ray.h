@@ -48,7 +48,8 @@ struct RayResult {
 // The opening every evaluator shares: clips the ray camera + t dir to the
 // atmosphere shell [bottom, top] into *seg and resets *out (transmittance 1,
 // hits_ground from the clip). Returns false when the ray does not cross the
-// atmosphere: *out is then the whole answer (L = 0, T = 1).
+// atmosphere: *out is then the whole answer (L = 0, T = 1) except for a camera
+// on the ground looking down (GroundAtCamera below), whose ground is still owed.
 ATMOS_HD inline bool BeginRay(const Vec3d& camera, const Vec3d& dir, double bottom, double top,
                               RayResult* out, AtmosphereSegment* seg) {
     *out = RayResult();
@@ -56,6 +57,16 @@ ATMOS_HD inline bool BeginRay(const Vec3d& camera, const Vec3d& dir, double bott
     *seg = ClipToAtmosphere(camera, dir, bottom, top);
     out->hits_ground = seg->hits_ground;
     return seg->inside;
+}
+
+// A camera on (or numerically below) the ground looking below its horizon:
+// the ray ends on the ground at the camera itself. ClipToAtmosphere gives it
+// an empty segment that ends on the ground (t_end = 0, hits_ground) and
+// BeginRay returns false, but the ray still sees the ground: the evaluator
+// shades the ground at the camera seen through no air (no sky, T = 1). The
+// precomputation stages use ClipToAtmosphere unchanged.
+ATMOS_HD inline bool GroundAtCamera(const AtmosphereSegment& seg) {
+    return !seg.inside && seg.hits_ground;
 }
 
 // True for evaluators that declare kStochastic (they take a pixel key).

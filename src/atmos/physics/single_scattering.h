@@ -29,7 +29,17 @@ ATMOS_HD inline RayResult IntegrateSingleScattering(const AtmosphereParameters& 
                                                     const Vec3d& sun, bool want_ground) {
     RayResult out;
     AtmosphereSegment seg;
-    if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) return out;
+    if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) {
+        // A camera on the ground looking down (physics/ray.h): the ground at the camera.
+        if (want_ground && GroundAtCamera(seg) && MaxComponent(atm.ground_albedo) > 0.0) {
+            const double cos_sun = Dot(Normalize(camera), sun);
+            Vec3d tau_sun;
+            if (cos_sun > 0.0 && medium.LightDepth(camera, sun, &tau_sun)) {
+                out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * Exp(-tau_sun));
+            }
+        }
+        return out;
+    }
     const double ds = (seg.t_end - seg.t_start) / steps;
     const double nu = Dot(dir, sun);
     Vec3d tau_view;  // camera to the start of the current step

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -19,6 +20,7 @@
 
 #include "atmos/error.h"
 #include "base/progress.h"
+#include "render/render.h"
 
 namespace atmos {
 
@@ -206,6 +208,45 @@ CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& ke
 
 }  // namespace
 
+namespace {
+
+// SIGINT / SIGTERM during a checkpointed render (issue 18 item 10): the
+// handler only records the signal and restores the default action (a second
+// signal ends the process at once); the driver finishes the pass, writes the
+// checkpoint and stops with one line saying how to resume.
+volatile sig_atomic_t g_stop_signal = 0;
+
+extern "C" void RecordStopSignal(int signal_number) { g_stop_signal = signal_number; }
+
+class StopSignalScope {
+  public:
+    explicit StopSignalScope(bool active) : active_(active) {
+        if (!active_) return;
+        g_stop_signal = 0;
+        struct sigaction action {};
+        action.sa_handler = RecordStopSignal;
+        sigemptyset(&action.sa_mask);
+        action.sa_flags = SA_RESETHAND;
+        sigaction(SIGINT, &action, &old_int_);
+        sigaction(SIGTERM, &action, &old_term_);
+    }
+    ~StopSignalScope() {
+        if (!active_) return;
+        sigaction(SIGINT, &old_int_, nullptr);
+        sigaction(SIGTERM, &old_term_, nullptr);
+    }
+    StopSignalScope(const StopSignalScope&) = delete;
+    StopSignalScope& operator=(const StopSignalScope&) = delete;
+    int Received() const { return active_ ? static_cast<int>(g_stop_signal) : 0; }
+
+  private:
+    bool active_;
+    struct sigaction old_int_ {};
+    struct sigaction old_term_ {};
+};
+
+}  // namespace
+
 int64_t PassSpp(const MonteCarloSettings& mc) {
     return mc.pass_spp > 0 ? mc.pass_spp : std::clamp<int64_t>(mc.spp / 8, 1, 64);
 }
@@ -289,6 +330,7 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
                       request.show_progress);
     Image pass_image;
     auto last_save = std::chrono::steady_clock::now();
+    const StopSignalScope stop(!stem.empty());
     for (int64_t p = passes_done; p < passes; ++p) {
         MonteCarloPass pass;
         pass.seed = mc.seed;
@@ -305,7 +347,9 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
         ++passes_done;
         samples_done += pass.samples;
         const auto now = std::chrono::steady_clock::now();
-        if (std::chrono::duration<double>(now - last_save).count() > 10.0 || p + 1 == passes) {
+        const int signal_number = stop.Received();
+        if (signal_number != 0 || std::chrono::duration<double>(now - last_save).count() > 10.0 ||
+            p + 1 == passes) {
             save_checkpoint();
             last_save = now;
         }
@@ -316,6 +360,12 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
                 save_checkpoint();  // keep the passes done
                 throw;
             }
+        }
+        if (signal_number != 0 && p + 1 < passes) {
+            Fail("interrupted by ", signal_number == SIGINT ? "SIGINT" : "SIGTERM", " after pass ",
+                 passes_done, " of ", passes, " (", samples_done, " of ", spp,
+                 " samples per pixel); the checkpoint '", path,
+                 "' holds them: the same command with --resume continues");
         }
     }
     // Mean, and the variance of the mean from the pass means (batch means):
@@ -333,6 +383,9 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
             request.variance->data()[i] = var;
         }
     }
+    // The mean (also one read back by --resume) goes through the output guard.
+    GuardOutput(out->data(), n);
+    if (request.variance) GuardOutput(request.variance->data(), n);
 }
 
 }  // namespace atmos

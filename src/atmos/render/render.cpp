@@ -1,5 +1,6 @@
 #include "render/render.h"
 
+#include <atomic>
 #include <cmath>
 
 #include "atmos/error.h"
@@ -20,6 +21,26 @@ PixelSetup MakePixelSetup(const RenderRequest& request, const AtmosphereParamete
     s.sun_disc_scale = static_cast<float>(1.0 / (kPi * alpha * alpha));
     return s;
 }
+
+namespace {
+std::atomic<int64_t> g_guarded{0};
+}  // namespace
+
+int64_t GuardOutput(float* values, size_t count) {
+    int64_t replaced = 0;
+    for (size_t i = 0; i < count; ++i) {
+        const float v = values[i];
+        if (!std::isfinite(v) || v < 0.0f) {
+            values[i] = 0.0f;
+            ++replaced;
+        }
+    }
+    if (replaced > 0) g_guarded.fetch_add(replaced);
+    return replaced;
+}
+
+int64_t OutputGuardCount() { return g_guarded.load(); }
+void ResetOutputGuardCount(int64_t value) { g_guarded.store(value); }
 
 void FailNoDeviceKernels(const char* evaluator) {
     Fail("device backend: evaluator ", evaluator,

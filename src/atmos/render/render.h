@@ -54,12 +54,12 @@ ATMOS_HD inline Rgb ShadePixel(const Evaluator& evaluator, const PixelSetup& s, 
         static_cast<uint64_t>(y) * static_cast<uint64_t>(s.width) + static_cast<uint64_t>(x);
     const RayResult r =
         EvaluateRay(evaluator, s.camera.position, dir, s.sun_direction, !s.transmittance, key);
-    if (s.transmittance) return SanitizeRadiance(r.transmittance);
+    if (s.transmittance) return r.transmittance;
     Rgb radiance = (r.sky + r.ground) * s.irradiance;
     if (s.sun_disc && !r.hits_ground && Dot(dir, s.sun_direction) >= s.cos_sun_radius) {
         radiance += s.irradiance * r.transmittance * s.sun_disc_scale;
     }
-    return SanitizeRadiance(radiance);
+    return radiance;  // RenderImage's output guard follows (GuardOutput)
 }
 
 // The sample contract of DESIGN.md for one query, through an evaluator.
@@ -74,10 +74,19 @@ ATMOS_HD inline SampleAnswer SampleOne(const Evaluator& evaluator, double bottom
     const Vec3d sun(sin_s * cos(az), sin_s * sin(az), q.mu_s);
     const RayResult r = EvaluateRay(evaluator, camera, dir, sun, false, key);
     SampleAnswer a;
-    a.radiance = SanitizeRadiance(r.sky);
-    a.transmittance = r.hits_ground ? Rgb(0.0f) : SanitizeRadiance(r.transmittance);
-    return a;
+    a.radiance = r.sky;
+    a.transmittance = r.hits_ground ? Rgb(0.0f) : r.transmittance;
+    return a;  // SampleAll's output guard follows (GuardOutput)
 }
+
+// The output guard (issue 18 item 3), the last step of every render and
+// sample on every backend (on the host, after the launch): replaces each NaN,
+// infinity and negative value of values[0, count) by 0 and returns how many it
+// replaced, adding them to the process-wide count that OutputGuardCount()
+// (atmos/model.h) reports. Models compute defined cases correctly and reject
+// undefined input, so a non-zero count is a defect: the CLI warns (an error
+// with --strict) and the test suite fails.
+int64_t GuardOutput(float* values, size_t count);
 
 // Throws the error of a device launch that cannot run: an evaluator without
 // device kernels (not in models/model_list.h; render/render.cpp).
@@ -156,6 +165,7 @@ void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView 
     stage.out.height = out.height;
     stage.out.channels = 3;
     RunStage("render", static_cast<int64_t>(setup.width) * setup.height, 256, stage, progress);
+    GuardOutput(out.data, static_cast<size_t>(out.width) * out.height * 3);
 }
 
 template <typename Evaluator>
@@ -184,6 +194,7 @@ std::vector<SampleAnswer> SampleAll(const Evaluator& evaluator, double bottom_ra
     stage.answers.width = static_cast<int>(answers.size());
     stage.answers.channels = kAnswerFloats;
     RunStage("sample", static_cast<int64_t>(queries.size()), 64, stage);
+    GuardOutput(reinterpret_cast<float*>(answers.data()), answers.size() * kAnswerFloats);
     return answers;
 }
 
