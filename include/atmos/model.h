@@ -79,9 +79,19 @@ struct SampleAnswer {
 // `pass_spp` paths (0: spp / 8 in [1, 64]), the granularity of checkpoints and
 // of the variance estimate. Other models ignore it.
 struct MonteCarloSettings {
-    int64_t spp = 64;
+    int64_t spp = 64;  // paths per pixel; with a noise target: the cap
     uint64_t seed = 0;
     int64_t pass_spp = 0;
+    // > 0: render until the HDR-FLIP between the mean of the even passes and
+    // the mean of the odd passes (two independent halves) is at or below this,
+    // or spp is reached (render/progressive.h).
+    double noise_target = 0.0;
+};
+
+// What a Monte Carlo render reached (RenderRequest::report).
+struct MonteCarloReport {
+    int64_t samples = 0;  // paths per pixel in the image
+    double noise = -1.0;  // HDR-FLIP between its two halves; < 0: not measured
 };
 
 // One pass of a Monte Carlo model: the mean of samples [first_sample,
@@ -109,6 +119,7 @@ struct RenderRequest {
     std::string checkpoint;
     bool resume = false;
     Image* variance = nullptr;
+    MonteCarloReport* report = nullptr;  // optional: filled by a Monte Carlo render
 };
 
 class Model {
