@@ -171,6 +171,7 @@ void ReferenceModel::Prepare(const AtmosphereParameters& atmosphere) {
     evaluator_.sun_cone_cos = sun_disc_light_ ? std::cos(atmosphere.sun_angular_radius) : 1.0;
     evaluator_.shells = BuildMajorantShells(atmosphere, shell_count_);
     std::lock_guard<std::mutex> lock(sun_table_mutex_);
+    resident_.Reset();
     sun_table_ready_ = false;
     sun_table_ = Table(2, 2, 1, 3);  // until built: a valid table for a device copy
     evaluator_.sun_table.tau = sun_table_.view();
@@ -219,6 +220,9 @@ void ReferenceModel::RenderPass(const RenderRequest& request, const MonteCarloPa
         e.sample_count = pass.samples;
         e.need_transmittance = request.sun_disc;  // the only use of T in a radiance pass
     }
+    // The sun table stays on the device from pass to pass.
+    ResidentScope scope(&resident_);
+    scope.Keep(e);
     RenderImage(e, setup, out->View(), progress);
 }
 
@@ -228,6 +232,8 @@ std::vector<SampleAnswer> ReferenceModel::SamplePass(const std::vector<SampleQue
     e.seed = pass.seed;
     e.sample_begin = pass.first_sample;
     e.sample_count = pass.samples;
+    ResidentScope scope(&resident_);
+    scope.Keep(e);
     return SampleAll(e, e.atm.bottom_radius, queries);
 }
 

@@ -934,6 +934,7 @@ class ReferenceModel : public MonteCarloModel {
     mutable Table sun_table_;
     mutable bool sun_table_ready_ = false;
     mutable std::mutex sun_table_mutex_;
+    mutable ResidentTables resident_;  // the sun table's device copy (render/stages.h)
     int shell_count_ = 48;
     bool sun_disc_light_ = false;
 };
