@@ -266,12 +266,16 @@ TEST(Cli, CompareMeasuresTheReferencesNoise) {
     std::istringstream noise(noise_csv);
     std::string line;
     std::getline(noise, line);
-    EXPECT_EQ(line, "view,reference_noise_flip,half_spp");
+    EXPECT_EQ(line, "view,reference_noise_flip,half_spp,noise_target");
     std::map<std::string, double> floor;
     while (std::getline(noise, line)) {
-        const size_t a = line.find(','), b = line.rfind(',');
-        floor[line.substr(0, a)] = std::stod(line.substr(a + 1, b - a - 1));
-        EXPECT_EQ(line.substr(b + 1), "2");  // two halves of 2 spp
+        std::vector<std::string> f;
+        std::istringstream fields(line);
+        for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+        ASSERT_EQ(f.size(), 4u) << line;
+        floor[f[0]] = std::stod(f[1]);
+        EXPECT_EQ(f[2], "2");  // two halves of 2 spp
+        EXPECT_EQ(f[3], "0");  // --reference-spp alone: no noise target
     }
     ASSERT_EQ(floor.size(), 2u);
     for (const auto& [view, flip] : floor) {
@@ -293,6 +297,46 @@ TEST(Cli, CompareMeasuresTheReferencesNoise) {
     ASSERT_EQ(again.status, 0) << again.err;
     EXPECT_NE(again.err.find("reference (reference) cached"), std::string::npos) << again.err;
     EXPECT_EQ(Slurp(dir / "out" / "reference_noise.csv"), noise_csv);
+}
+
+// A noise target: each view's reference renders until the FLIP between its
+// halves is at or below it (reached and reported per view), or stops at the
+// --reference-spp cap (reported above the target).
+TEST(Cli, CompareRendersTheReferenceToANoiseTarget) {
+    const fs::path dir = TempDir("compare-noise-target");
+    auto run = [&](const std::string& target, const std::string& cap) {
+        const std::string args =
+            "compare --models empty --views space,ground-noon --size 32x18 "
+            "--reference-noise " +
+            target + " --reference-spp " + cap + " --no-cache -o " + (dir / "out").string();
+        CliRun r = Atmos(args, dir);
+        EXPECT_EQ(r.status, 0) << r.err;
+        std::istringstream noise(Slurp(dir / "out" / "reference_noise.csv"));
+        std::string line;
+        std::getline(noise, line);
+        std::vector<std::vector<std::string>> rows;
+        while (std::getline(noise, line)) {
+            std::vector<std::string> f;
+            std::istringstream fields(line);
+            for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+            rows.push_back(f);
+        }
+        return rows;
+    };
+    // Reachable: at or below the target, with more than the first pair of passes
+    // somewhere (the first check is at 2 x 16 paths).
+    for (const auto& f : run("0.2", "4096")) {
+        ASSERT_EQ(f.size(), 4u);
+        EXPECT_LE(std::stod(f[1]), 0.2) << f[0];
+        EXPECT_GE(std::stoll(f[2]), 8) << f[0];
+        EXPECT_EQ(std::stod(f[3]), 0.2);
+    }
+    // Unreachable within the cap: stops at the cap, above the target.
+    for (const auto& f : run("0.0001", "16")) {
+        ASSERT_EQ(f.size(), 4u);
+        EXPECT_GT(std::stod(f[1]), 0.0001) << f[0];
+        EXPECT_EQ(f[2], "8") << f[0];  // two halves of 8 paths
+    }
 }
 
 // Variants of one model side by side: NAME:OPTION=VALUE specs. More view-ray

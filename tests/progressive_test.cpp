@@ -19,6 +19,7 @@
 #include "atmos/model.h"
 #include "base/progress.h"
 #include "base/rng.h"
+#include "metrics/flip.h"
 #include "render/progressive.h"
 
 namespace atmos {
@@ -292,6 +293,64 @@ TEST(Progressive, ADamagedCheckpointIsOneClearError) {
     EXPECT_EQ(std::memcmp(resumed.data(), full.data(), full.size() * sizeof(float)), 0);
     // The temporary file is gone once committed.
     EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+}
+
+}  // namespace
+}  // namespace atmos
+
+namespace atmos {
+namespace {
+
+// A noise target: pairs of passes (even and odd: the two halves), checked as
+// they grow, stopping at the target or the spp cap; the image is the plain
+// render of the same samples, and a checkpoint (with the halves) resumes it.
+TEST(Progressive, RendersToANoiseTargetOrTheCap) {
+    const CoinModel model(true);
+    Image plain;
+    model.Render(CoinRequest(12, 3), &plain);
+    // Unreachable: the cap, above the target, the same image as the plain render.
+    RenderRequest request = CoinRequest(12, 3);
+    request.monte_carlo.noise_target = 1e-6;
+    MonteCarloReport report;
+    request.report = &report;
+    Image capped;
+    model.Render(request, &capped);
+    EXPECT_EQ(report.samples, 12);
+    EXPECT_GT(report.noise, 1e-6);
+    ASSERT_EQ(capped.size(), plain.size());
+    EXPECT_EQ(std::memcmp(capped.data(), plain.data(), plain.size() * sizeof(float)), 0);
+    // Reached at once: one pair of passes.
+    request.monte_carlo.noise_target = 0.99;
+    Image quick;
+    model.Render(request, &quick);
+    EXPECT_EQ(report.samples, 6);
+    EXPECT_LE(report.noise, 0.99);
+    // The noise is the FLIP between the even pass (samples 0-2) and the odd one (3-5).
+    Image even, odd;
+    MonteCarloPass pass;
+    pass.seed = 11;
+    pass.samples = 3;
+    model.RenderPass(request, pass, &even, nullptr);
+    pass.first_sample = 3;
+    model.RenderPass(request, pass, &odd, nullptr);
+    EXPECT_NEAR(report.noise, HdrFlip(even, odd).mean, 1e-6);
+    // Resumed from a checkpoint of the first pair: the capped image again.
+    const std::filesystem::path dir = TestDir("progressive_noise");
+    request.monte_carlo.noise_target = 1e-6;
+    request.monte_carlo.spp = 6;
+    request.checkpoint = (dir / "coin").string();
+    model.Render(request, &quick);
+    request.monte_carlo.spp = 12;
+    request.resume = true;
+    Image resumed;
+    const int before = model.passes_rendered;
+    model.Render(request, &resumed);
+    EXPECT_EQ(model.passes_rendered - before, 2);
+    EXPECT_EQ(report.samples, 12);
+    EXPECT_EQ(std::memcmp(resumed.data(), plain.data(), plain.size() * sizeof(float)), 0);
+    // A noise target out of range is one clear error.
+    request.monte_carlo.noise_target = 1.5;
+    EXPECT_THROW(model.Render(request, &resumed), Error);
 }
 
 }  // namespace

@@ -7,11 +7,21 @@
 namespace atmos::cli {
 
 bool MonteCarloFlags::Given() const {
-    return spp_flag->count() + seed_flag->count() + pass_flag->count() > 0;
+    return spp_flag->count() + seed_flag->count() + pass_flag->count() +
+               (noise_flag ? noise_flag->count() : 0) >
+           0;
 }
 
 MonteCarloSettings MonteCarloFlags::Checked() const {
-    return MakeMonteCarloSettings(spp, seed, pass_spp);
+    // With a noise target --spp is the cap; not given, it is 65536.
+    const bool noise_given = noise_flag && noise_flag->count() > 0;
+    const int64_t cap = noise_given && spp_flag->count() == 0 ? 65536 : spp;
+    MonteCarloSettings mc = MakeMonteCarloSettings(cap, seed, pass_spp);
+    if (noise_given) {
+        if (!(noise > 0.0 && noise < 1.0)) Fail("--noise must be in (0, 1), got ", noise);
+        mc.noise_target = noise;
+    }
+    return mc;
 }
 
 MonteCarloSettings MonteCarloFlags::Settings(const ModelInfo& model) const {
@@ -22,7 +32,7 @@ MonteCarloSettings MonteCarloFlags::Settings(const ModelInfo& model) const {
     return Checked();
 }
 
-void AddMonteCarloFlags(CLI::App* cmd, MonteCarloFlags* flags) {
+void AddMonteCarloFlags(CLI::App* cmd, MonteCarloFlags* flags, bool with_noise) {
     const char* group = "Monte Carlo models (e.g. reference)";
     flags->spp_flag =
         cmd->add_option("--spp", flags->spp, "paths per pixel (per query for sample), >= 1")
@@ -38,6 +48,14 @@ void AddMonteCarloFlags(CLI::App* cmd, MonteCarloFlags* flags) {
                         "more spp with --resume")
             ->capture_default_str()
             ->group(group);
+    if (with_noise) {
+        flags->noise_flag =
+            cmd->add_option("--noise", flags->noise,
+                            "render until the HDR-FLIP between the image's two halves (its even "
+                            "and odd passes) is at or below this, in (0, 1); --spp is then the "
+                            "cap (default 65536)")
+                ->group(group);
+    }
 }
 
 }  // namespace atmos::cli

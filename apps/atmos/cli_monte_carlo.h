@@ -13,7 +13,9 @@ struct MonteCarloFlags {
     int64_t spp = 64;
     int64_t seed = 0;
     int64_t pass_spp = 0;
+    double noise = 0.0;  // render: a noise target (0: off)
     CLI::Option* spp_flag = nullptr;
+    CLI::Option* noise_flag = nullptr;
     CLI::Option* seed_flag = nullptr;
     CLI::Option* pass_flag = nullptr;
 
@@ -25,6 +27,7 @@ struct MonteCarloFlags {
     MonteCarloSettings Settings(const ModelInfo& model) const;
 };
 
-void AddMonteCarloFlags(CLI::App* cmd, MonteCarloFlags* flags);
+// `with_noise`: also --noise (renders only).
+void AddMonteCarloFlags(CLI::App* cmd, MonteCarloFlags* flags, bool with_noise = false);
 
 }  // namespace atmos::cli

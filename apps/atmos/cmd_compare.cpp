@@ -24,6 +24,10 @@ namespace {
 // The reference model when none is given and `reference` is not registered.
 constexpr const char* kStandInReference = "naive";
 constexpr int kDefaultReferenceSpp = 64;
+// The main job's default: a noise target (HDR-FLIP between the reference's
+// halves), capped at kDefaultReferenceCap paths per pixel.
+constexpr double kDefaultReferenceNoise = 0.01;
+constexpr int kDefaultReferenceCap = 1024;
 
 struct CompareCliOptions {
     std::vector<std::string> models, views, sets;
@@ -32,7 +36,9 @@ struct CompareCliOptions {
     std::string reference;
     int64_t reference_spp = kDefaultReferenceSpp;
     int64_t reference_seed = 0;
+    double reference_noise = kDefaultReferenceNoise;
     CLI::Option* spp_flag = nullptr;
+    CLI::Option* noise_flag = nullptr;
     CLI::Option* seed_flag = nullptr;
     std::string atmosphere = "earth";
     std::string output;
@@ -83,7 +89,8 @@ int CmdCompare(const CompareCliOptions& o) {
     config.command_line = o.command_line;
 
     // The reference: `reference` (the path tracer) when registered, else a stand-in.
-    const bool monte_carlo_given = o.spp_flag->count() + o.seed_flag->count() > 0;
+    const bool monte_carlo_given =
+        o.spp_flag->count() + o.seed_flag->count() + o.noise_flag->count() > 0;
     if (!o.reference.empty()) {
         const ModelSpec reference = ParseModelSpec(o.reference);
         config.reference_model = reference.name;
@@ -99,11 +106,25 @@ int CmdCompare(const CompareCliOptions& o) {
             "stand-in: the path tracer `reference` is not registered in this build";
     }
     if (GetModelInfo(config.reference_model).capabilities.stochastic) {
-        config.reference_monte_carlo = MakeMonteCarloSettings(
-            o.reference_spp, o.reference_seed, 0, "--reference-spp", "--reference-seed");
+        if (!(o.reference_noise >= 0.0 && o.reference_noise < 1.0)) {
+            Fail("--reference-noise must be in [0, 1) (0: a fixed --reference-spp), got ",
+                 o.reference_noise);
+        }
+        // The default is a noise target capped at kDefaultReferenceCap paths;
+        // --reference-spp alone is a fixed count (noise off), with
+        // --reference-noise the cap.
+        const bool noise_given = o.noise_flag->count() > 0;
+        const bool spp_given = o.spp_flag->count() > 0;
+        const double noise = noise_given ? o.reference_noise : spp_given ? 0.0 : o.reference_noise;
+        const int64_t spp = noise > 0.0 && !spp_given ? kDefaultReferenceCap : o.reference_spp;
+        config.reference_monte_carlo =
+            MakeMonteCarloSettings(spp, o.reference_seed, 0, "--reference-spp", "--reference-seed");
+        config.reference_monte_carlo.noise_target = noise;
     } else if (monte_carlo_given) {
-        Fail("--reference-spp and --reference-seed need a Monte Carlo reference model (",
-             config.reference_model, " is not one)");
+        Fail(
+            "--reference-spp, --reference-seed and --reference-noise need a Monte Carlo "
+            "reference model (",
+            config.reference_model, " is not one)");
     }
     CreateModel(config.reference_model, config.reference_options);  // validate the options
 
@@ -139,9 +160,17 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
     cmd->add_option("--size,-s", o->size, "image size WIDTHxHEIGHT")->capture_default_str();
     cmd->add_option("--quantity", o->quantity, "radiance (HDR-FLIP) or transmittance (LDR-FLIP)")
         ->capture_default_str();
+    o->noise_flag =
+        cmd->add_option("--reference-noise", o->reference_noise,
+                        "noise target of a Monte Carlo reference: each view renders until the "
+                        "HDR-FLIP between its two halves (even and odd passes) is at or below it, "
+                        "at most --reference-spp paths per pixel (default then 1024); 0, or "
+                        "--reference-spp given alone: a fixed --reference-spp (two halves of "
+                        "spp/2, seeds 2s+1 and 2s+2)")
+            ->capture_default_str();
     o->spp_flag = cmd->add_option("--reference-spp", o->reference_spp,
-                                  "paths per pixel of a Monte Carlo reference (two halves of "
-                                  "spp/2, seeds 2s+1 and 2s+2)")
+                                  "paths per pixel of a Monte Carlo reference: alone, a fixed "
+                                  "count (two halves of spp/2); with --reference-noise, the cap")
                       ->capture_default_str();
     o->seed_flag = cmd->add_option("--reference-seed", o->reference_seed,
                                    "random seed s of a Monte Carlo reference, in [0, 4294967295]")

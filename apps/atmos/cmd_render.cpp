@@ -90,6 +90,8 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         request.monte_carlo = monte_carlo;
         const bool stochastic = model->Info().capabilities.stochastic;
         Image variance;
+        MonteCarloReport report;
+        request.report = &report;
         std::string out_stem = fs::path(ro.output).replace_extension().string();
         if (all_views) {
             out_stem = (fs::path(ro.output) / (common.model + "-" + view.name)).string();
@@ -122,6 +124,13 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         if (!request.checkpoint.empty() && !ro.keep_checkpoint) {
             std::error_code ignored;
             fs::remove(request.checkpoint + ".bin", ignored);
+        }
+        if (!common.quiet && report.noise >= 0.0) {
+            std::fprintf(stderr,
+                         "%s: noise %.4f (HDR-FLIP between its halves) at %lld paths per "
+                         "pixel%s\n",
+                         view.name.c_str(), report.noise, static_cast<long long>(report.samples),
+                         report.noise <= monte_carlo.noise_target ? "" : " (the --spp cap)");
         }
         if (!common.quiet) {
             std::fprintf(stderr, "rendered %-22s %dx%d with %s in %.3f s (%d threads)\n",
@@ -169,7 +178,7 @@ Command AddRenderCommand(CLI::App* root) {
                      "is deleted");
     render->add_flag("--resume", ro->resume,
                      "Monte Carlo models: continue from the checkpoint of the same render");
-    AddMonteCarloFlags(render, &ro->monte_carlo);
+    AddMonteCarloFlags(render, &ro->monte_carlo, true);
     c.app = render;
     c.run = [common, ro] { return CmdRender(*common, *ro); };
     return c;

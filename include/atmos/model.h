@@ -80,9 +80,19 @@ struct SampleAnswer {
 // `pass_spp` paths (0: spp / 8 in [1, 64]), the granularity of checkpoints and
 // of the variance estimate. Other models ignore it.
 struct MonteCarloSettings {
-    int64_t spp = 64;
+    int64_t spp = 64;  // paths per pixel; with a noise target: the cap
     uint64_t seed = 0;
     int64_t pass_spp = 0;
+    // > 0: render until the HDR-FLIP between the mean of the even passes and
+    // the mean of the odd passes (two independent halves) is at or below this,
+    // or spp is reached (render/progressive.h).
+    double noise_target = 0.0;
+};
+
+// What a Monte Carlo render reached (RenderRequest::report).
+struct MonteCarloReport {
+    int64_t samples = 0;  // paths per pixel in the image
+    double noise = -1.0;  // HDR-FLIP between its two halves; < 0: not measured
 };
 
 // One pass of a Monte Carlo model: the mean of samples [first_sample,
@@ -114,6 +124,7 @@ struct RenderRequest {
     // (passes done, passes in all, counting resumed ones); may throw to stop
     // the render (the checkpoint keeps the passes done). Others ignore it.
     std::function<void(int64_t, int64_t)> on_pass;
+    MonteCarloReport* report = nullptr;  // optional: filled by a Monte Carlo render
 };
 
 class Model {

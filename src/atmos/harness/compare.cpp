@@ -47,11 +47,14 @@ class LazyRenderer {
         key_.quantity = config.quantity;
     }
 
-    Image Render(const View& view, double* seconds, bool* cached) {
+    Image Render(const View& view, double* seconds, bool* cached,
+                 MonteCarloReport* report = nullptr) {
         RenderKey key = key_;
         key.view = view.name;
         Image image;
-        if (cache_.Load(key, &image, seconds)) {
+        MonteCarloReport local;
+        if (!report) report = &local;
+        if (cache_.Load(key, &image, seconds, report)) {
             *cached = true;
             return image;
         }
@@ -69,11 +72,12 @@ class LazyRenderer {
         request.quantity = config_.quantity;
         request.show_progress = config_.show_progress;
         request.monte_carlo = monte_carlo_;
+        request.report = report;
         const auto start = std::chrono::steady_clock::now();
         model_->Render(request, &image);
         *seconds = SecondsSince(start);
         *cached = false;
-        cache_.Store(key, image, *seconds);
+        cache_.Store(key, image, *seconds, key.monte_carlo ? report : nullptr);
         return image;
     }
 
@@ -228,8 +232,12 @@ CompareResult RunCompare(const CompareConfig& config) {
     // number of paths), whose difference measures its noise.
     const ModelInfo& reference_info = GetModelInfo(config.reference_model);
     const MonteCarloSettings& mc = config.reference_monte_carlo;
+    // A noise target: one render whose even and odd passes are the halves
+    // (render/progressive.h), until their FLIP reaches the target.
+    const bool noise_target =
+        !transmittance && reference_info.capabilities.stochastic && mc.noise_target > 0.0;
     const bool split_reference =
-        !transmittance && reference_info.capabilities.stochastic && mc.spp >= 2;
+        !noise_target && !transmittance && reference_info.capabilities.stochastic && mc.spp >= 2;
     MonteCarloSettings half_a = mc, half_b = mc;
     int64_t spp_a = 0, spp_b = 0;
     if (split_reference) {
@@ -240,7 +248,10 @@ CompareResult RunCompare(const CompareConfig& config) {
         half_a.seed = 2 * mc.seed + 1;
         half_b.seed = 2 * mc.seed + 2;
     }
-    LazyRenderer reference(config.reference_model, config.reference_options, config, cache, half_a);
+    MonteCarloSettings whole = mc;
+    if (!noise_target) whole.noise_target = 0.0;
+    LazyRenderer reference(config.reference_model, config.reference_options, config, cache,
+                           split_reference ? half_a : whole);
     LazyRenderer reference_b(config.reference_model, config.reference_options, config, cache,
                              half_b);
     std::vector<std::unique_ptr<LazyRenderer>> renderers;
@@ -258,7 +269,11 @@ CompareResult RunCompare(const CompareConfig& config) {
         const fs::path error_dir = out / "errors" / FileStem(view.name);
         fs::create_directories(image_dir);
         fs::create_directories(error_dir);
-        Image ref = reference.Render(view, &row.reference_seconds, &row.reference_cached);
+        MonteCarloReport ref_report;
+        Image ref =
+            reference.Render(view, &row.reference_seconds, &row.reference_cached, &ref_report);
+        row.reference_spp = ref_report.samples;
+        if (noise_target) row.reference_noise = ref_report.noise;
         if (split_reference) {
             double seconds_b = 0.0;
             bool cached_b = false;
@@ -269,14 +284,23 @@ CompareResult RunCompare(const CompareConfig& config) {
                 ref.data()[i] = wa * ref.data()[i] + (1.0f - wa) * b.data()[i];
             }
             row.reference_seconds += seconds_b;
+            row.reference_spp = spp_a + spp_b;
             row.reference_cached = row.reference_cached && cached_b;
         }
         WriteImages(ref, image_dir, "reference", exposure, config.write_npy);
         row.reference_png = (fs::path("images") / FileStem(view.name) / "reference.png").string();
         if (config.show_progress) {
-            std::fprintf(stderr, "%-22s reference (%s) %s %.3f s\n", view.name.c_str(),
+            std::fprintf(stderr, "%-22s reference (%s) %s %.3f s", view.name.c_str(),
                          config.reference_model.c_str(),
                          row.reference_cached ? "cached" : "rendered", row.reference_seconds);
+            if (row.reference_noise >= 0.0) {
+                std::fprintf(stderr, "  noise %.4f at %lld spp%s", row.reference_noise,
+                             static_cast<long long>(row.reference_spp),
+                             noise_target && row.reference_noise > mc.noise_target
+                                 ? " (cap reached, above the target)"
+                                 : "");
+            }
+            std::fprintf(stderr, "\n");
         }
         for (size_t m = 0; m < result.models.size(); ++m) {
             const std::string& name = result.models[m];
@@ -343,11 +367,12 @@ CompareResult RunCompare(const CompareConfig& config) {
     }
     WriteMetricCsv((out / "flip.csv").string(), "FLIP errors", labels, result.models, flips);
     WriteMetricCsv((out / "rmse.csv").string(), "RMSE errors", labels, result.models, rmses);
-    if (split_reference) {
+    if (split_reference || noise_target) {
         std::ofstream f(out / "reference_noise.csv");
-        f << "view,reference_noise_flip,half_spp\n";
+        f << "view,reference_noise_flip,half_spp,noise_target\n";
         for (const CompareRow& row : result.rows) {
-            f << row.view << "," << row.reference_noise << "," << spp_a << "\n";
+            f << row.view << "," << row.reference_noise << "," << row.reference_spp / 2 << ","
+              << (noise_target ? mc.noise_target : 0.0) << "\n";
         }
     }
     {

@@ -31,7 +31,10 @@ struct CompareConfig {
     Quantity quantity = Quantity::kRadiance;
     std::string reference_model = "naive";
     std::map<std::string, std::string> reference_options;
-    // A Monte Carlo reference's estimate (spp, seed; split into halves, see CompareRow).
+    // A Monte Carlo reference's estimate (spp, seed; split into halves, see
+    // CompareRow). With reference_monte_carlo.noise_target > 0 each view's
+    // reference renders until its halves' HDR-FLIP is at or below the target
+    // (spp: the cap).
     MonteCarloSettings reference_monte_carlo;
     std::string reference_note;  // how the reference was chosen (shown in the report)
     std::string atmosphere_name = "earth";
@@ -70,6 +73,7 @@ struct CompareRow {
     // halves: the reference's own noise, an upper bound for its error at the full
     // spp. Negative when not measured (deterministic reference, transmittance).
     double reference_noise = -1.0;
+    int64_t reference_spp = 0;       // paths per pixel of the (whole) reference
     std::vector<CompareCell> cells;  // one per model, in CompareResult::models order
 };
 

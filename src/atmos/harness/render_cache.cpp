@@ -41,7 +41,9 @@ std::string RenderKeyText(const RenderKey& key) {
     for (const auto& [name, value] : key.options) os << "option " << name << "=" << value << "\n";
     if (key.monte_carlo) {
         os << "monte-carlo spp=" << key.mc.spp << " seed=" << key.mc.seed
-           << " pass-spp=" << key.mc.pass_spp << "\n";
+           << " pass-spp=" << key.mc.pass_spp;
+        if (key.mc.noise_target > 0.0) os << " noise-target=" << key.mc.noise_target;
+        os << "\n";
     }
     os << "view " << key.view << "\n";
     os << "size " << key.width << "x" << key.height << "\n";
@@ -76,7 +78,8 @@ std::string RenderCache::ImagePath(const RenderKey& key) const {
     return (fs::path(directory_) / (stem + ".exr")).string();
 }
 
-bool RenderCache::Load(const RenderKey& key, Image* image, double* render_seconds) const {
+bool RenderCache::Load(const RenderKey& key, Image* image, double* render_seconds,
+                       MonteCarloReport* report) const {
     if (!enabled()) return false;
     const std::string exr = ImagePath(key);
     const std::string meta = exr.substr(0, exr.size() - 4) + ".json";
@@ -90,13 +93,18 @@ bool RenderCache::Load(const RenderKey& key, Image* image, double* render_second
         if (loaded.width() != key.width || loaded.height() != key.height) return false;
         *image = std::move(loaded);
         *render_seconds = j.at("render_seconds").get<double>();
+        if (report) {
+            report->samples = j.value("samples", static_cast<int64_t>(0));
+            report->noise = j.value("noise", -1.0);
+        }
         return true;
     } catch (const std::exception&) {
         return false;  // a damaged entry is re-rendered (and overwritten)
     }
 }
 
-void RenderCache::Store(const RenderKey& key, const Image& image, double render_seconds) const {
+void RenderCache::Store(const RenderKey& key, const Image& image, double render_seconds,
+                        const MonteCarloReport* report) const {
     if (!enabled()) return;
     fs::create_directories(directory_);
     const std::string exr = ImagePath(key);
@@ -105,6 +113,10 @@ void RenderCache::Store(const RenderKey& key, const Image& image, double render_
     nlohmann::json j;
     j["key"] = RenderKeyText(key);
     j["render_seconds"] = render_seconds;
+    if (report) {
+        j["samples"] = report->samples;
+        j["noise"] = report->noise;
+    }
     std::ofstream f(meta);
     f << j.dump(1) << "\n";
     if (!f) Fail("cannot write '", meta, "'");

@@ -47,8 +47,11 @@ class RenderCache {
     explicit RenderCache(std::string directory);
     bool enabled() const { return !directory_.empty(); }
     // Loads the image and the seconds its render took; false when absent or stale.
-    bool Load(const RenderKey& key, Image* image, double* render_seconds) const;
-    void Store(const RenderKey& key, const Image& image, double render_seconds) const;
+    // A Monte Carlo render's report (reached noise, paths) travels with it.
+    bool Load(const RenderKey& key, Image* image, double* render_seconds,
+              MonteCarloReport* report = nullptr) const;
+    void Store(const RenderKey& key, const Image& image, double render_seconds,
+               const MonteCarloReport* report = nullptr) const;
     // The EXR file of a key (whether or not it exists).
     std::string ImagePath(const RenderKey& key) const;
 

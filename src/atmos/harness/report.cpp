@@ -212,9 +212,12 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
     if (!r.rows.empty() && r.rows.front().reference_noise >= 0.0) {
         f << " The path-traced reference is the average of two independent halves; <i>reference "
              "noise</i> is the HDR-FLIP between them (<a href=\"reference_noise.csv\">"
-             "reference_noise.csv</a>), an upper bound of the reference's own error. A FLIP at or "
-             "below it (&asymp;, grey) is not resolved by this reference: raise "
-             "<code>--reference-spp</code> to rank those models.";
+             "reference_noise.csv</a>: the noise reached and the paths per pixel of each view; "
+             "with <code>--reference-noise</code> each view renders until it is at or below the "
+             "target or reaches the <code>--reference-spp</code> cap), an upper bound of the "
+             "reference's own error. A FLIP at or below it (&asymp;, grey) is not resolved by "
+             "this reference: lower <code>--reference-noise</code> (or raise the cap) to rank "
+             "those models.";
     }
     f << "</p>\n";
     MetricTable(f,

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "atmos/error.h"
+#include "base/parallel.h"
 
 namespace atmos {
 
@@ -67,6 +68,44 @@ MajorantShells BuildMajorantShells(const AtmosphereParameters& atm, int count) {
     return shells;
 }
 
+Vec3d SunOpticalDepthQuadrature(const AtmosphereParameters& atm, double r, double mu,
+                                int intervals) {
+    intervals += intervals & 1;
+    const double d = DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius);
+    const double h = d / intervals;
+    Vec3d sum;
+    for (int i = 0; i <= intervals; ++i) {
+        const double t = i * h;
+        const double ri = std::sqrt(std::max(r * r + 2.0 * r * mu * t + t * t, 0.0));
+        const double w = (i == 0 || i == intervals) ? 1.0 : ((i & 1) ? 4.0 : 2.0);
+        sum += Extinction(atm, GetDensities(atm, ri - atm.bottom_radius)) * w;
+    }
+    return sum * (h / 3.0);
+}
+
+Table BuildSunOpticalDepthTable(const AtmosphereParameters& atm, int mu_size, int r_size,
+                                int intervals) {
+    Table table(mu_size, r_size, 1, 3);
+    const double bottom = atm.bottom_radius, top = atm.top_radius;
+    const double H = std::sqrt(top * top - bottom * bottom);
+    ParallelFor(r_size, 1, [&](int64_t j) {
+        const double x_r = static_cast<double>(j) / (r_size - 1);
+        const double rho = x_r * H;
+        const double r = std::sqrt(rho * rho + bottom * bottom);
+        const double d_min = top - r, d_max = rho + H;
+        for (int i = 0; i < mu_size; ++i) {
+            const double x_mu = static_cast<double>(i) / (mu_size - 1);
+            const double d = d_min + x_mu * (d_max - d_min);
+            const double mu =
+                d == 0.0 ? 1.0 : std::clamp((H * H - rho * rho - d * d) / (2.0 * r * d), -1.0, 1.0);
+            const Vec3d tau = SunOpticalDepthQuadrature(atm, r, mu, intervals);
+            float* texel = table.Texel(i, static_cast<int>(j));
+            for (int c = 0; c < 3; ++c) texel[c] = static_cast<float>(tau[c]);
+        }
+    });
+    return table;
+}
+
 ModelInfo ReferenceModel::StaticInfo() {
     ModelInfo info;
     info.name = "reference";
@@ -88,21 +127,41 @@ const OptionTable<ReferenceOptions>& ReferenceModel::OptionRows() {
             .Integer("sun-disc-light", &O::sun_disc_light, 0, 1, "",
                      "1: light from the sun's disc (angular radius from the atmosphere), sampled "
                      "per next-event estimate; 0: a directional sun like the other models")
-            .Choice("estimator", &O::spectral, {{"spectral", true}, {"thesis", false}},
-                    "spectral: all channels per path (spectral tracking, forced first collision, "
-                    "ratio-tracked sun); thesis: the thesis's estimator (one random channel per "
-                    "path, delta tracking, uniform directions), kept as a baseline")
+            .Choice("estimator", &O::estimator,
+                    {{"hybrid", ReferenceEstimator::kHybrid},
+                     {"tracking", ReferenceEstimator::kTracking},
+                     {"spectral", ReferenceEstimator::kTracking},
+                     {"thesis", ReferenceEstimator::kThesis}},
+                    "hybrid: order 1 by converged quadrature along the view ray, orders >= 2 by "
+                    "paths whose first vertex is drawn from the same table, the sun's "
+                    "transmittance from a converged table, looser continuation majorants; "
+                    "tracking (alias spectral): spectral tracking, forced first collision, "
+                    "ratio-tracked sun (the default before 0.6); thesis: the thesis's estimator "
+                    "(one random channel per path, delta tracking, uniform directions), kept as "
+                    "a baseline")
             .Integer("max-order", &O::max_order, 0, 1e6, "",
                      "highest scattering order (volume or ground vertices); 0: unlimited")
-            .Integer("shells", &O::shells, 1, kMaxReferenceShells, "",
-                     "altitude shells of the majorant (1: one global majorant)");
+            .Integer("shells", &O::shells, 0, kMaxReferenceShells, "",
+                     "altitude shells of the majorant (1: one global majorant; 0: 8 for hybrid, "
+                     "48 for tracking and thesis)")
+            .Real("majorant-scale", &O::majorant_scale, 1.0, 64.0, "",
+                  "hybrid: factor on the majorants of continuation segments (more, cheaper "
+                  "next-event estimates per path)");
     return table;
 }
 
 ReferenceModel::ReferenceModel(const ReferenceOptions& options) : info_(StaticInfo()) {
-    shell_count_ = options.shells;
+    const bool hybrid = options.estimator == ReferenceEstimator::kHybrid;
+    if (hybrid && options.sun_disc_light != 0) {
+        Fail(
+            "model reference: sun-disc-light=1 needs estimator=tracking (the hybrid "
+            "estimator's order 1 is for a directional sun)");
+    }
+    shell_count_ = options.shells > 0 ? options.shells : (hybrid ? 8 : 48);
     evaluator_.max_order = options.max_order;
-    evaluator_.spectral = options.spectral;
+    evaluator_.estimator = options.estimator;
+    evaluator_.spectral = options.estimator != ReferenceEstimator::kThesis;
+    evaluator_.continuation_majorant_scale = options.majorant_scale;
     sun_disc_light_ = options.sun_disc_light != 0;
     Prepare(EarthAtmosphere());
 }
@@ -111,12 +170,36 @@ void ReferenceModel::Prepare(const AtmosphereParameters& atmosphere) {
     evaluator_.atm = atmosphere;
     evaluator_.sun_cone_cos = sun_disc_light_ ? std::cos(atmosphere.sun_angular_radius) : 1.0;
     evaluator_.shells = BuildMajorantShells(atmosphere, shell_count_);
+    std::lock_guard<std::mutex> lock(sun_table_mutex_);
+    resident_.Reset();
+    sun_table_ready_ = false;
+    sun_table_ = Table(2, 2, 1, 3);  // until built: a valid table for a device copy
+    evaluator_.sun_table.tau = sun_table_.view();
+    evaluator_.sun_table.bottom = atmosphere.bottom_radius;
+    evaluator_.sun_table.top = atmosphere.top_radius;
+}
+
+const ReferenceEvaluator& ReferenceModel::evaluator() const {
+    std::lock_guard<std::mutex> lock(sun_table_mutex_);
+    if (!sun_table_ready_ && evaluator_.estimator == ReferenceEstimator::kHybrid) {
+        sun_table_ = BuildSunOpticalDepthTable(evaluator_.atm, kSunTableMuSize, kSunTableRSize,
+                                               kSunTableIntervals);
+        evaluator_.sun_table.tau = sun_table_.view();
+    }
+    sun_table_ready_ = true;
+    return evaluator_;
 }
 
 std::string ReferenceModel::PassKey() const {
     nlohmann::json key;
     key["max_order"] = evaluator_.max_order;
-    key["estimator"] = evaluator_.spectral ? "spectral" : "thesis";
+    key["estimator"] = evaluator_.estimator == ReferenceEstimator::kHybrid     ? "hybrid"
+                       : evaluator_.estimator == ReferenceEstimator::kTracking ? "spectral"
+                                                                               : "thesis";
+    if (evaluator_.estimator == ReferenceEstimator::kHybrid) {
+        key["majorant_scale"] = evaluator_.continuation_majorant_scale;
+        key["sun_table"] = {kSunTableMuSize, kSunTableRSize, kSunTableIntervals};
+    }
     key["sun_cone_cos"] = evaluator_.sun_cone_cos;
     key["shells"] = evaluator_.shells.count;
     key["atmosphere"] = nlohmann::json::parse(AtmosphereToJson(evaluator_.atm));
@@ -127,7 +210,7 @@ void ReferenceModel::RenderPass(const RenderRequest& request, const MonteCarloPa
                                 Image* out, Progress* progress) const {
     const PixelSetup setup = MakePixelSetup(request, evaluator_.atm);
     out->Resize(request.width, request.height);
-    ReferenceEvaluator e = evaluator_;
+    ReferenceEvaluator e = evaluator();
     e.seed = pass.seed;
     if (request.quantity == Quantity::kTransmittance) {
         // Deterministic: no paths needed (T does not depend on them).
@@ -137,15 +220,20 @@ void ReferenceModel::RenderPass(const RenderRequest& request, const MonteCarloPa
         e.sample_count = pass.samples;
         e.need_transmittance = request.sun_disc;  // the only use of T in a radiance pass
     }
+    // The sun table stays on the device from pass to pass.
+    ResidentScope scope(&resident_);
+    scope.Keep(e);
     RenderImage(e, setup, out->View(), progress);
 }
 
 std::vector<SampleAnswer> ReferenceModel::SamplePass(const std::vector<SampleQuery>& queries,
                                                      const MonteCarloPass& pass) const {
-    ReferenceEvaluator e = evaluator_;
+    ReferenceEvaluator e = evaluator();
     e.seed = pass.seed;
     e.sample_begin = pass.first_sample;
     e.sample_count = pass.samples;
+    ResidentScope scope(&resident_);
+    scope.Keep(e);
     return SampleAll(e, e.atm.bottom_radius, queries);
 }
 

@@ -55,9 +55,12 @@
 
 #include <stdint.h>
 
+#include <mutex>
+
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "base/rng.h"
+#include "base/texture.h"
 #include "models/evaluator_model.h"
 #include "physics/density.h"
 #include "physics/geometry.h"
@@ -89,6 +92,59 @@ MajorantShells BuildMajorantShells(const AtmosphereParameters& atm, int count);
 // The exact maximum of a profile's (clamped) density over altitudes [h0, h1].
 double MaxProfileDensity(const DensityProfile& profile, double h0, double h1);
 
+// The estimators of `reference` (its `estimator` option).
+enum class ReferenceEstimator : int {
+    // The default: order 1 by deterministic quadrature along the view ray, the
+    // Monte Carlo part (orders >= 2) from a first vertex drawn from the same
+    // per-pixel table (pdf ~ sigma_s T_view), the sun's transmittance from a
+    // converged table, looser continuation majorants (see HybridPath).
+    kHybrid = 0,
+    // Spectral tracking with a forced first collision and ratio-tracked sun
+    // (the default until this round).
+    kTracking = 1,
+    // The thesis's estimator (seed 003 section 4), kept as a baseline.
+    kThesis = 2,
+};
+
+// The sun's transmittance from a point (r, mu_s) to space: 0 when the ray meets
+// the ground (exact geometry), else exp(-tau) with tau bilinear in a table of
+// the optical depth on seed 004's transmittance parameterisation (x_r =
+// rho / H, x_mu = (d - d_min) / (d_max - d_min)), filled by Simpson quadrature
+// (BuildSunOpticalDepthTable). Its error against exact quadrature is measured
+// and bounded by a test (ReferenceHybrid.SunTableMatchesQuadrature).
+struct SunTransmittanceTable {
+    TableView tau;  // 3 channels: optical depth to the top boundary
+    double bottom = 0.0, top = 0.0;
+
+    ATMOS_HD Vec3d Lookup(double r, double mu) const {
+        if (RayIntersectsGround(r, mu, bottom)) return Vec3d(0.0);
+        r = Clamp(r, bottom, top);
+        const double H = Sqrt(top * top - bottom * bottom);
+        const double rho = SafeSqrt(r * r - bottom * bottom);
+        const double d = DistanceToTopAtmosphereBoundary(r, mu, top);
+        const double d_min = top - r;
+        const double d_max = rho + H;
+        const double x_mu = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
+        const double x_r = rho / H;
+        const Vec4f v = tau.SampleBilinear(GetTextureCoordFromUnitRange(x_mu, tau.width),
+                                           GetTextureCoordFromUnitRange(x_r, tau.height));
+        return Exp(-Vec3d(v.x, v.y, v.z));
+    }
+};
+
+// Fills a table of mu_size x r_size texels (Simpson, `intervals` per ray).
+Table BuildSunOpticalDepthTable(const AtmosphereParameters& atm, int mu_size, int r_size,
+                                int intervals = 512);
+// Optical depth from (r, mu) to the top boundary by composite Simpson with
+// `intervals` (even) intervals (what the table holds at its texels).
+Vec3d SunOpticalDepthQuadrature(const AtmosphereParameters& atm, double r, double mu,
+                                int intervals);
+
+// The view ray's per-pixel table of the hybrid estimator: about this many
+// intervals in all, at most kHybridMaxNodes nodes.
+constexpr int kHybridViewIntervals = 96;
+constexpr int kHybridMaxNodes = 128;
+
 struct ReferenceEvaluator {
     static constexpr bool kStochastic = true;
 
@@ -107,6 +163,20 @@ struct ReferenceEvaluator {
     // toward the sun, directions sampled uniformly). Kept as the baseline the
     // spectral estimator is measured against (bench, docs/models/reference.md).
     bool spectral = true;
+    // The estimator; kTracking with spectral = false is the thesis's. (The
+    // evaluator's default stays kTracking so that an evaluator made without a
+    // sun table works; the model's default is kHybrid.)
+    ReferenceEstimator estimator = ReferenceEstimator::kTracking;
+    // kHybrid: the sun's transmittance table and the factor (>= 1) on the
+    // continuation segments' majorants.
+    SunTransmittanceTable sun_table;
+    double continuation_majorant_scale = 4.0;
+
+    template <typename V>
+    void VisitTables(V& v) {
+        v(sun_table.tau);
+    }
+
     // 1: the sun is a point (directional light, as the other models); < 1: the
     // sun is a uniform disc of angular radius acos(sun_cone_cos), sampled
     // uniformly in its cone for each next-event estimate (the irradiance stays
@@ -430,29 +500,392 @@ struct ReferenceEvaluator {
         }
     }
 
+    // ---- the hybrid estimator (ReferenceEstimator::kHybrid) ----
+    //
+    // The radiance of a view segment [0, L] is order 1 (light scattered once,
+    // toward the camera, from the sun) plus orders >= 2. Order 1 is
+    //   L1 = int_0^L T(t) [sigma_R(t) P_R(nu) + sigma_M(t) P_M(nu)] T_sun(x(t)) dt
+    //        (+ T(L) rho/pi cos_s T_sun(x(L)) on a reflecting ground),
+    // computed deterministically by composite Simpson on a per-pixel table of
+    // nodes (uniform within pieces split at the planet's shadow cylinder, so
+    // T_sun's jump there is a piece boundary). Orders >= 2 are one Monte Carlo
+    // path per sample: its first real vertex is drawn from the same table,
+    // in the volume with pdf ~ mean_c(sigma_s,c T_c) (interval by its
+    // trapezoid mass, then uniform in it; the weight uses sigma_s and T at the
+    // drawn point exactly: T by the table's optical depth at the interval's
+    // start plus the trapezoid of sigma_t over the partial interval), or on the
+    // ground (probability P_g, below); every path thus scatters for real at
+    // least once, and its next-event estimates start at order 2. The path then
+    // continues by spectral tracking against the shells' majorants times
+    // continuation_majorant_scale (next-event estimation at every tentative
+    // collision: a looser majorant means more, cheaper estimates), the sun's
+    // transmittance of every estimate from sun_table.
+    struct ViewNode {
+        double t;
+        Vec3d tau;      // view optical depth from the segment's start
+        Vec3d sigma_t;  // extinction at the node
+        double cdf;     // first-vertex mass of the intervals before this node
+        // Build-time only: dt/du, Rayleigh and Mie densities, sun transmittance.
+        double jac, rho_r, rho_m;
+        Vec3d sun_t;
+    };
+
+    ATMOS_HD Vec3d SunTransmittanceAt(const Vec3d& p, const Vec3d& sun) const {
+        const double r = Length(p);
+        return sun_table.Lookup(r, ClampCosine(Dot(p, sun) / r));
+    }
+
+    // Where p + t dir crosses the planet's shadow cylinder (radius bottom,
+    // axis -sun) on its night side, for t in (0, length): up to 2, sorted.
+    ATMOS_HD int ShadowCrossings(const Vec3d& p, const Vec3d& dir, const Vec3d& sun, double length,
+                                 double* out) const {
+        const Vec3d pp = p - sun * Dot(p, sun);
+        const Vec3d dp = dir - sun * Dot(dir, sun);
+        const double a = Dot(dp, dp);
+        const double b = Dot(pp, dp);
+        const double c = Dot(pp, pp) - atm.bottom_radius * atm.bottom_radius;
+        const double disc = b * b - a * c;
+        int n = 0;
+        if (a <= 0.0 || disc <= 0.0) return 0;
+        const double q = Sqrt(disc);
+        const double roots[2] = {(-b - q) / a, (-b + q) / a};
+        for (double t : roots) {
+            if (t > 0.0 && t < length && Dot(p + dir * t, sun) < 0.0) out[n++] = t;
+        }
+        return n;
+    }
+
+    // Builds the table (returns the node count) and order 1 of the volume.
+    //
+    // Pieces: the segment is cut at its lowest point (the tangent point, where
+    // the altitude turns) and where it crosses the planet's shadow, so that in
+    // each piece the altitude is monotonic and the sun's transmittance smooth.
+    // In each piece t = a + (b - a) u^2 from its low end (u uniform, n_k even
+    // intervals, about kHybridViewIntervals in all by length): nodes are dense
+    // where the air is. Integrals over t are Simpson's rule in u with the
+    // Jacobian dt/du (the integrand times it is smooth, also at u = 0); the
+    // optical depth at odd nodes by the 3-point rule h/12 (5 g0 + 8 g1 - g2).
+    ATMOS_HD int BuildViewTable(const Vec3d& start, const Vec3d& dir, const Vec3d& sun,
+                                double length, ViewNode* nodes, Vec3d* order1) const {
+        double cuts[6];
+        int nc = 0;
+        cuts[nc++] = 0.0;
+        const double t_low = -Dot(start, dir);
+        if (t_low > 1e-6 * length && t_low < (1.0 - 1e-6) * length) cuts[nc++] = t_low;
+        double crossings[2];
+        const int ns = ShadowCrossings(start, dir, sun, length, crossings);
+        for (int i = 0; i < ns; ++i) {
+            // Insert sorted (at most 4 cuts so far).
+            int j = nc++;
+            while (j > 0 && cuts[j - 1] > crossings[i]) {
+                cuts[j] = cuts[j - 1];
+                --j;
+            }
+            cuts[j] = crossings[i];
+        }
+        cuts[nc++] = length;
+        const double nu = Dot(dir, sun);
+        const double p_r = RayleighPhase(nu);
+        const double p_m = CornetteShanksPhase(atm.mie_phase_g, nu);
+        // Phase 1: nodes (positions, Jacobians, densities, sun transmittance).
+        int count = 0;
+        int piece_start[6], piece_n[6];
+        for (int k = 0; k + 1 < nc; ++k) {
+            const double a = cuts[k], b = cuts[k + 1];
+            const double span = b - a;
+            int n = static_cast<int>(kHybridViewIntervals * span / length + 0.5);
+            n = Max(4, n + (n & 1));
+            n = Min(n, kHybridMaxNodes - 1 - count - 4 * (nc - 2 - k));
+            n -= n & 1;
+            const bool low_at_a = Length(start + dir * a) <= Length(start + dir * b);
+            piece_start[k] = count;
+            piece_n[k] = n;
+            for (int i = (k == 0 ? 0 : 1); i <= n; ++i) {
+                const double u = static_cast<double>(i) / n;
+                double t, jac;
+                if (low_at_a) {
+                    t = a + span * u * u;
+                    jac = 2.0 * span * u;
+                } else {
+                    t = b - span * (1.0 - u) * (1.0 - u);
+                    jac = 2.0 * span * (1.0 - u);
+                }
+                if (i == n) t = b;
+                const Vec3d x = start + dir * t;
+                const Densities d = GetDensities(atm, Length(x) - atm.bottom_radius);
+                ViewNode& node = nodes[count++];
+                node.t = t;
+                node.jac = jac;
+                node.rho_r = d.rayleigh;
+                node.rho_m = d.mie;
+                node.sigma_t = Extinction(atm, d);
+                // The sun's transmittance just inside the piece at its ends
+                // (it jumps at a shadow crossing: each piece takes its side).
+                const double ts = i == 0 ? t + 1e-7 * span : (i == n ? t - 1e-7 * span : t);
+                node.sun_t = SunTransmittanceAt(start + dir * ts, sun);
+            }
+        }
+        // Phase 2: optical depths, order 1 and the first-vertex masses.
+        Vec3d o1;
+        nodes[0].tau = Vec3d(0.0);
+        nodes[0].cdf = 0.0;
+        for (int k = 0; k + 1 < nc; ++k) {
+            const int s0 = k == 0 ? 0 : piece_start[k] - 1;  // the piece's node u = 0
+            const int n = piece_n[k];
+            const double h = 1.0 / n;
+            // The first node of a later piece is the previous piece's last
+            // node, except for its sun transmittance (the other side of a cut).
+            const Vec3d sun0 =
+                k == 0 ? nodes[0].sun_t
+                       : SunTransmittanceAt(
+                             start + dir * (cuts[k] + 1e-7 * (cuts[k + 1] - cuts[k])), sun);
+            // dt/du at the piece's u = 0 (the previous node holds the last
+            // piece's value there).
+            const bool low_at_a =
+                Length(start + dir * cuts[k]) <= Length(start + dir * cuts[k + 1]);
+            const double jac0 = low_at_a ? 0.0 : 2.0 * (cuts[k + 1] - cuts[k]);
+            for (int i = 0; i <= n; ++i) {
+                const ViewNode& node = nodes[s0 + i];
+                const double jac = i == 0 ? jac0 : node.jac;
+                const Vec3d sun_t = i == 0 ? sun0 : node.sun_t;
+                if (i > 0) {
+                    ViewNode& cur = nodes[s0 + i];
+                    const ViewNode& p1 = nodes[s0 + i - 1];
+                    const double j1 = i - 1 == 0 ? jac0 : p1.jac;
+                    if (i & 1) {
+                        const ViewNode& n1 = nodes[s0 + i + 1];
+                        cur.tau = p1.tau + (p1.sigma_t * (5.0 * j1) + cur.sigma_t * (8.0 * jac) -
+                                            n1.sigma_t * n1.jac) *
+                                               (h / 12.0);
+                    } else {
+                        const ViewNode& p2 = nodes[s0 + i - 2];
+                        const double j2 = i - 2 == 0 ? jac0 : p2.jac;
+                        cur.tau = p2.tau +
+                                  (p2.sigma_t * j2 + p1.sigma_t * (4.0 * j1) + cur.sigma_t * jac) *
+                                      (h / 3.0);
+                    }
+                    const Vec3d sigma_s_prev =
+                        atm.rayleigh_scattering * p1.rho_r + atm.mie_scattering * p1.rho_m;
+                    const Vec3d sigma_s =
+                        atm.rayleigh_scattering * cur.rho_r + atm.mie_scattering * cur.rho_m;
+                    const double g0 = Dot(sigma_s_prev * Exp(-p1.tau), Vec3d(1.0 / 3.0));
+                    const double g1 = Dot(sigma_s * Exp(-cur.tau), Vec3d(1.0 / 3.0));
+                    cur.cdf = p1.cdf + 0.5 * (cur.t - p1.t) * (g0 + g1);
+                }
+                const double wgt = (i == 0 || i == n) ? 1.0 : ((i & 1) ? 4.0 : 2.0);
+                const Vec3d f = (atm.rayleigh_scattering * (node.rho_r * p_r) +
+                                 atm.mie_scattering * (node.rho_m * p_m)) *
+                                Exp(-nodes[s0 + i].tau) * sun_t;
+                o1 += f * (jac * wgt * h / 3.0);
+            }
+        }
+        *order1 = o1;
+        return count;
+    }
+
+    // Continues a path from a real vertex (direction already sampled): adds
+    // every next-event estimate (orders >= order + 1) to *radiance.
+    ATMOS_HD void HybridContinue(Vec3d p, Vec3d dir, Vec3d w, int order, const Vec3d& sun, Rng& rng,
+                                 Vec3d* radiance) const {
+        int shell = shells.ShellOf(Length(p));
+        const double bar = 1.0 / 3.0;
+        const double k = continuation_majorant_scale;
+        for (int guard = 0; guard < 1000000; ++guard) {
+            const Step step = Track(&p, dir, &shell, rng, k);
+            if (step == Step::kEscaped) break;
+            if (step == Step::kGround) {
+                ++order;
+                if (max_order > 0 && order > max_order) break;
+                if (MaxComponent(atm.ground_albedo) <= 0.0) break;
+                const Vec3d n = Normalize(p);
+                const double cos_sun = Dot(n, sun);
+                if (cos_sun > 0.0) {
+                    *radiance +=
+                        w * atm.ground_albedo * (cos_sun / kPi) * SunTransmittanceAt(p, sun);
+                }
+                dir = MakeDirection(n, SampleCosineHemisphereCosine(rng.Uniform()), rng.Uniform());
+                w = w * atm.ground_albedo;
+            } else {
+                const Densities d = GetDensities(atm, Length(p) - atm.bottom_radius);
+                const Vec3d sigma_r = atm.rayleigh_scattering * d.rayleigh;
+                const Vec3d sigma_m = atm.mie_scattering * d.mie;
+                const double sigma_bar = k * shells.majorant[shell];
+                const Vec3d sigma_n = Vec3d(sigma_bar) - Extinction(atm, d);
+                const double a_r = Dot(w, sigma_r) * bar;
+                const double a_m = Dot(w, sigma_m) * bar;
+                const double a_n = Max(Dot(w, sigma_n), 0.0) * bar;
+                const double total = a_r + a_m + a_n;
+                if (!(total > 0.0)) break;
+                // Next-event estimate with the expected value of the event
+                // choice (as TracePath).
+                if (max_order == 0 || order < max_order) {
+                    const double nu = Dot(dir, sun);
+                    const Vec3d scatter = sigma_r * RayleighPhase(nu) +
+                                          sigma_m * CornetteShanksPhase(atm.mie_phase_g, nu);
+                    if (MaxComponent(w * scatter) > 0.0) {
+                        *radiance += w * scatter * (1.0 / sigma_bar) * SunTransmittanceAt(p, sun);
+                    }
+                }
+                const double xi = rng.Uniform() * total;
+                if (xi >= a_r + a_m) {
+                    w = w * sigma_n * (1.0 / (sigma_bar * (a_n / total)));
+                    continue;
+                }
+                const bool rayleigh = xi < a_r;
+                w = w * (rayleigh ? sigma_r : sigma_m) *
+                    (1.0 / (sigma_bar * ((rayleigh ? a_r : a_m) / total)));
+                ++order;
+                if (max_order > 0 && order >= max_order) break;
+                dir = SamplePhaseDirection(dir, rayleigh, rng, &w);
+            }
+            if (order >= 3) {
+                const double q = Min(0.95, MaxComponent(w));
+                if (rng.Uniform() >= q) break;
+                w = w * (1.0 / q);
+            }
+        }
+    }
+
+    ATMOS_HD Vec3d SamplePhaseDirection(const Vec3d& dir, bool rayleigh, Rng& rng, Vec3d* w) const {
+        if (rayleigh) {
+            return MakeDirection(dir, SampleRayleighCosine(rng.Uniform()), rng.Uniform());
+        }
+        const double mu = SampleHenyeyGreensteinCosine(atm.mie_phase_g, rng.Uniform());
+        *w = *w * CornetteShanksOverHenyeyGreenstein(atm.mie_phase_g, mu);
+        return MakeDirection(dir, mu, rng.Uniform());
+    }
+
+    // The hybrid estimate of one view segment from `start` (length 0 with
+    // hits_ground: a camera on the ground looking down).
+    ATMOS_HD void EvaluateHybrid(const Vec3d& start, const Vec3d& dir, const Vec3d& sun,
+                                 double length, bool hits_ground, uint64_t key, Vec3d* sky,
+                                 Vec3d* ground, Vec3d* tau_out) const {
+        ViewNode nodes[kHybridMaxNodes];
+        Vec3d order1;
+        int count = 1;
+        if (length > 0.0) {
+            count = BuildViewTable(start, dir, sun, length, nodes, &order1);
+        } else {
+            nodes[0] = {0.0, Vec3d(0.0), Vec3d(0.0), 0.0, 0.0, 0.0, 0.0, Vec3d(0.0)};
+        }
+        const Vec3d tau_end = nodes[count - 1].tau;
+        *tau_out = tau_end;
+        const double mass = nodes[count - 1].cdf;  // int mean_c(sigma_s T) dt
+        const bool reflective = hits_ground && MaxComponent(atm.ground_albedo) > 0.0;
+        const Vec3d t_end = Exp(-tau_end);
+        const Vec3d ground_point = start + dir * length;
+        const Vec3d normal = Normalize(ground_point);
+        // Order 1 (deterministic).
+        *sky += order1 * static_cast<double>(sample_count);
+        if (reflective) {
+            const double cos_sun = Dot(normal, sun);
+            if (cos_sun > 0.0) {
+                *ground += t_end * atm.ground_albedo * (cos_sun / kPi) *
+                           SunTransmittanceAt(ground_point, sun) *
+                           static_cast<double>(sample_count);
+            }
+        }
+        if (max_order == 1) return;
+        // The first real vertex: ground with probability p_ground, else the volume.
+        const double ground_mass =
+            reflective ? Dot(t_end * atm.ground_albedo, Vec3d(1.0 / 3.0)) : 0.0;
+        double p_ground = 0.0;
+        if (ground_mass > 0.0) {
+            p_ground = mass > 0.0 ? Clamp(ground_mass / (ground_mass + mass), 0.05, 0.95) : 1.0;
+        }
+        if (!(mass > 0.0) && p_ground <= 0.0) return;
+        for (int64_t s = 0; s < sample_count; ++s) {
+            Rng rng(seed, key, static_cast<uint64_t>(sample_begin + s));
+            if (rng.Uniform() < p_ground) {
+                const Vec3d w = t_end * atm.ground_albedo * (1.0 / p_ground);
+                const Vec3d next = MakeDirection(
+                    normal, SampleCosineHemisphereCosine(rng.Uniform()), rng.Uniform());
+                // A hair above the ground so the first track starts inside.
+                HybridContinue(normal * (atm.bottom_radius + 1e-3), next, w, 1, sun, rng, ground);
+                continue;
+            }
+            // Interval by its mass (binary search on the cdf), then uniform.
+            const double u = rng.Uniform() * mass;
+            int lo = 0, hi = count - 1;  // nodes[lo].cdf <= u < nodes[hi].cdf
+            while (hi - lo > 1) {
+                const int mid = (lo + hi) / 2;
+                if (nodes[mid].cdf <= u) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            const ViewNode& a = nodes[lo];
+            const ViewNode& b = nodes[hi];
+            const double width = b.t - a.t;
+            const double p_interval = (b.cdf - a.cdf) / mass;
+            if (!(p_interval > 0.0) || !(width > 0.0)) continue;
+            const double t = a.t + rng.Uniform() * width;
+            const Vec3d x = start + dir * t;
+            const Densities d = GetDensities(atm, Length(x) - atm.bottom_radius);
+            const Vec3d sigma_t = Extinction(atm, d);
+            const Vec3d trans = Exp(-(a.tau + (a.sigma_t + sigma_t) * (0.5 * (t - a.t))));
+            const double pdf = (1.0 - p_ground) * p_interval / width;
+            const Vec3d w0 = trans * (1.0 / pdf);
+            const Vec3d sigma_r = atm.rayleigh_scattering * d.rayleigh;
+            const Vec3d sigma_m = atm.mie_scattering * d.mie;
+            const double a_r = Dot(w0, sigma_r), a_m = Dot(w0, sigma_m);
+            if (!(a_r + a_m > 0.0)) continue;
+            const bool rayleigh = rng.Uniform() * (a_r + a_m) < a_r;
+            Vec3d w =
+                w0 * (rayleigh ? sigma_r * ((a_r + a_m) / a_r) : sigma_m * ((a_r + a_m) / a_m));
+            const Vec3d next = SamplePhaseDirection(dir, rayleigh, rng, &w);
+            HybridContinue(x, next, w, 1, sun, rng, sky);
+        }
+    }
+
     ATMOS_HD RayResult EvaluateKeyed(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                      bool want_ground, uint64_t key) const {
         RayResult out;
-        AtmosphereSegment seg;
-        if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) return out;
-        const Vec3d start = camera + dir * seg.t_start;
-        if (need_transmittance) {
-            out.transmittance =
-                Rgb(Exp(-OpticalDepth(atm, start, dir, seg.t_end - seg.t_start, 1024)));
+        out.transmittance = Rgb(1.0f);
+        AtmosphereSegment seg = ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
+        out.hits_ground = seg.hits_ground;
+        // A camera on the ground looking down sees the ground at its feet: a
+        // segment of length 0 that ends on the ground (issue 18 item 2; the
+        // clip gives such rays an empty segment).
+        const bool ground_at_camera = seg.hits_ground && !(seg.t_end > seg.t_start);
+        if (ground_at_camera) {
+            seg.t_start = seg.t_end = 0.0;
+        } else if (!seg.inside) {
+            return out;
         }
-        const int shell = seg.t_start > 0.0 ? shells.count - 1 : shells.ShellOf(Length(start));
-        // Forced first collision unless the segment ends on a reflecting ground.
-        const bool reflective_end = seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0;
-        const double forced =
-            reflective_end ? 0.0 : MajorantDepth(start, dir, shell, seg.t_end - seg.t_start);
+        const Vec3d start =
+            ground_at_camera ? Normalize(camera) * atm.bottom_radius : camera + dir * seg.t_start;
+        const double length = seg.t_end - seg.t_start;
         Vec3d sky, ground;
-        for (int64_t s = 0; s < sample_count; ++s) {
-            Rng rng(seed, key, static_cast<uint64_t>(sample_begin + s));
-            if (spectral) {
-                TracePath(start, dir, shell, sun, rng, forced, seg.t_end - seg.t_start, &sky,
-                          &ground);
-            } else {
-                TracePathThesis(start, dir, shell, sun, rng, &sky, &ground);
+        if (estimator == ReferenceEstimator::kHybrid) {
+            if (sample_count <= 0) {  // the transmittance alone: the same table
+                if (length > 0.0) {
+                    ViewNode nodes[kHybridMaxNodes];
+                    Vec3d order1;
+                    const int n = BuildViewTable(start, dir, sun, length, nodes, &order1);
+                    out.transmittance = Rgb(Exp(-nodes[n - 1].tau));
+                }
+                return out;
+            }
+            Vec3d tau;
+            EvaluateHybrid(start, dir, sun, length, seg.hits_ground, key, &sky, &ground, &tau);
+            out.transmittance = Rgb(Exp(-tau));
+        } else {
+            if (need_transmittance && length > 0.0) {
+                out.transmittance = Rgb(Exp(-OpticalDepth(atm, start, dir, length, 1024)));
+            }
+            const int shell = seg.t_start > 0.0 ? shells.count - 1 : shells.ShellOf(Length(start));
+            // Forced first collision unless the segment ends on a reflecting ground.
+            const bool reflective_end = seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0;
+            const double forced = reflective_end ? 0.0 : MajorantDepth(start, dir, shell, length);
+            for (int64_t s = 0; s < sample_count; ++s) {
+                Rng rng(seed, key, static_cast<uint64_t>(sample_begin + s));
+                if (spectral) {
+                    TracePath(start, dir, shell, sun, rng, forced, length, &sky, &ground);
+                } else {
+                    TracePathThesis(start, dir, shell, sun, rng, &sky, &ground);
+                }
             }
         }
         if (sample_count > 0) {
@@ -466,10 +899,17 @@ struct ReferenceEvaluator {
 
 struct ReferenceOptions {
     int sun_disc_light = 0;  // 1: light from the sun's disc
-    bool spectral = true;    // estimator: spectral (true) or the thesis's (false)
-    int max_order = 0;       // 0: unlimited
-    int shells = 48;         // altitude shells of the majorant
+    ReferenceEstimator estimator = ReferenceEstimator::kHybrid;
+    int max_order = 0;            // 0: unlimited
+    int shells = 0;               // altitude shells of the majorant (0: 8 hybrid, 48 else)
+    double majorant_scale = 4.0;  // hybrid: factor on the continuation majorants
 };
+
+// The sun's optical-depth table of the hybrid estimator: texels along x_mu and
+// x_r, and the Simpson intervals per texel (error bound: reference_test.cpp).
+constexpr int kSunTableMuSize = 512;
+constexpr int kSunTableRSize = 256;
+constexpr int kSunTableIntervals = 128;
 
 // The host side: one pass is the evaluator with the pass's seed and samples;
 // the passes, checkpoints and variance are the progressive driver's.
@@ -485,11 +925,16 @@ class ReferenceModel : public MonteCarloModel {
     std::vector<SampleAnswer> SamplePass(const std::vector<SampleQuery>& queries,
                                          const MonteCarloPass& pass) const override;
     std::string PassKey() const override;
-    const ReferenceEvaluator& evaluator() const { return evaluator_; }
+    // The evaluator (its sun table built on first use after Prepare).
+    const ReferenceEvaluator& evaluator() const;
 
   private:
     ModelInfo info_;
-    ReferenceEvaluator evaluator_;
+    mutable ReferenceEvaluator evaluator_;
+    mutable Table sun_table_;
+    mutable bool sun_table_ready_ = false;
+    mutable std::mutex sun_table_mutex_;
+    mutable ResidentTables resident_;  // the sun table's device copy (render/stages.h)
     int shell_count_ = 48;
     bool sun_disc_light_ = false;
 };

@@ -20,6 +20,7 @@
 
 #include "atmos/error.h"
 #include "base/progress.h"
+#include "metrics/flip.h"
 #include "render/render.h"
 
 namespace atmos {
@@ -36,6 +37,10 @@ void RequireMonteCarlo(const Model& model) {
 void CheckSettings(const MonteCarloSettings& mc) {
     if (mc.spp < 1) Fail("Monte Carlo render: spp must be at least 1, got ", mc.spp);
     if (mc.pass_spp < 0) Fail("Monte Carlo render: pass spp must be >= 0, got ", mc.pass_spp);
+    if (!(mc.noise_target >= 0.0) || mc.noise_target >= 1.0) {
+        Fail("Monte Carlo render: the noise target must be in (0, 1) (0: off), got ",
+             mc.noise_target);
+    }
 }
 
 // Everything that determines a render's passes; a checkpoint resumes only the
@@ -59,6 +64,8 @@ nlohmann::json CheckpointKey(const Model& model, const RenderRequest& request, i
     key["sun_disc"] = request.sun_disc;
     key["seed"] = request.monte_carlo.seed;
     key["pass_spp"] = pass_spp;
+    // A noise-targeted render also keeps the even passes' sum (its halves).
+    if (request.monte_carlo.noise_target > 0.0) key["halves"] = true;
     return key;
 }
 
@@ -83,6 +90,7 @@ struct CheckpointState {
     int64_t passes_done = 0;
     int64_t samples_done = 0;
     Image sum, sum_sq;
+    Image sum_even;  // the even passes' sum (noise-targeted renders only; else empty)
 };
 
 void WriteAll(int fd, const std::string& bytes, const std::string& path) {
@@ -107,6 +115,7 @@ void WriteCheckpoint(const std::string& path, const nlohmann::json& key,
     header["height"] = state.sum.height();
     header["passes_done"] = state.passes_done;
     header["samples_done"] = state.samples_done;
+    header["even_sum"] = state.sum_even.size() > 0;
     const std::string text = header.dump();
     const uint64_t header_size = text.size();
     const size_t image_bytes = state.sum.size() * sizeof(float);
@@ -117,6 +126,9 @@ void WriteCheckpoint(const std::string& path, const nlohmann::json& key,
     bytes.append(text);
     bytes.append(reinterpret_cast<const char*>(state.sum.data()), image_bytes);
     bytes.append(reinterpret_cast<const char*>(state.sum_sq.data()), image_bytes);
+    if (state.sum_even.size() > 0) {
+        bytes.append(reinterpret_cast<const char*>(state.sum_even.data()), image_bytes);
+    }
     const uint64_t checksum = Fnv1a(bytes.data(), bytes.size());
     bytes.append(reinterpret_cast<const char*>(&checksum), sizeof checksum);
 
@@ -143,7 +155,7 @@ void WriteCheckpoint(const std::string& path, const nlohmann::json& key,
 // Reads and verifies a checkpoint of the render `key` (passes of pass_spp,
 // spp in all): one atmos::Error for anything that does not add up.
 CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& key, int width,
-                               int height, int64_t spp, int64_t pass_spp) {
+                               int height, int64_t spp, int64_t pass_spp, bool halves) {
     auto damaged = [&](const std::string& why) {
         Fail("checkpoint '", path, "' is damaged (", why,
              "); remove it or drop --resume to start over");
@@ -182,7 +194,9 @@ CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& ke
         damaged("header fields missing");
     }
     const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height) * 3;
-    if (bytes.size() != fixed + header_size + 2 * n * sizeof(float)) damaged("wrong size");
+    const size_t images = halves ? 3 : 2;
+    if (header.value("even_sum", false) != halves) damaged("its halves do not match the render");
+    if (bytes.size() != fixed + header_size + images * n * sizeof(float)) damaged("wrong size");
     // Every pass but a last one holds pass_spp samples.
     const bool counts_ok = s.passes_done >= 0 && s.samples_done >= 0 &&
                            s.samples_done <= s.passes_done * pass_spp &&
@@ -197,12 +211,18 @@ CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& ke
     std::memcpy(s.sum.data(), bytes.data() + 16 + header_size, n * sizeof(float));
     std::memcpy(s.sum_sq.data(), bytes.data() + 16 + header_size + n * sizeof(float),
                 n * sizeof(float));
+    if (halves) {
+        s.sum_even.Resize(width, height);
+        std::memcpy(s.sum_even.data(), bytes.data() + 16 + header_size + 2 * n * sizeof(float),
+                    n * sizeof(float));
+    }
     for (size_t i = 0; i < n; ++i) {
         if (!std::isfinite(s.sum.data()[i]) || !std::isfinite(s.sum_sq.data()[i]) ||
-            s.sum_sq.data()[i] < 0.0f) {
+            s.sum_sq.data()[i] < 0.0f || (halves && !std::isfinite(s.sum_even.data()[i]))) {
             damaged("a sum is not finite");
         }
     }
+    if (halves && s.passes_done % 2 != 0) damaged("a noise-targeted render ends on an odd pass");
     return s;
 }
 
@@ -248,7 +268,9 @@ class StopSignalScope {
 }  // namespace
 
 int64_t PassSpp(const MonteCarloSettings& mc) {
-    return mc.pass_spp > 0 ? mc.pass_spp : std::clamp<int64_t>(mc.spp / 8, 1, 64);
+    if (mc.pass_spp > 0) return mc.pass_spp;
+    if (mc.noise_target > 0.0) return std::clamp<int64_t>(mc.spp / 2, 1, 16);
+    return std::clamp<int64_t>(mc.spp / 8, 1, 64);
 }
 
 MonteCarloSettings MakeMonteCarloSettings(int64_t spp, int64_t seed, int64_t pass_spp,
@@ -297,7 +319,10 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     // can be estimated from the pass means).
     const int64_t spp = mc.spp;
     const int64_t pass_spp = PassSpp(mc);
-    const int64_t passes = (spp + pass_spp - 1) / pass_spp;
+    const bool noise_mode = mc.noise_target > 0.0;
+    // A noise target: whole pairs of passes (even, odd: the two halves).
+    int64_t passes = (spp + pass_spp - 1) / pass_spp;
+    if (noise_mode) passes = std::max<int64_t>(2, passes + (passes & 1));
     out->Resize(request.width, request.height);
     const size_t n = out->size();
 
@@ -308,9 +333,11 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     CheckpointState state;
     state.sum.Resize(request.width, request.height);
     state.sum_sq.Resize(request.width, request.height);
+    if (noise_mode) state.sum_even.Resize(request.width, request.height);
     if (!stem.empty() && request.resume) {
         if (std::filesystem::exists(path)) {
-            state = ReadCheckpoint(path, key, request.width, request.height, spp, pass_spp);
+            state = ReadCheckpoint(path, key, request.width, request.height,
+                                   noise_mode ? passes * pass_spp : spp, pass_spp, noise_mode);
         } else if (std::filesystem::exists(stem + ".json")) {
             Fail("checkpoint '", stem,
                  ".json' is in an older atmos format (sums in EXR files); remove it or drop "
@@ -331,11 +358,37 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     Image pass_image;
     auto last_save = std::chrono::steady_clock::now();
     const StopSignalScope stop(!stem.empty());
-    for (int64_t p = passes_done; p < passes; ++p) {
+    // A noise target: the halves' FLIP after pairs of passes, at sample counts
+    // growing geometrically (or as FLIP ~ spp^-0.45 predicts, at most x3).
+    double noise = -1.0;
+    int64_t next_check = 0;
+    auto measure_noise = [&]() {
+        const int64_t half = samples_done / 2;  // even and odd halves hold the same count
+        Image a(request.width, request.height), b(request.width, request.height);
+        const float inv_half = 1.0f / static_cast<float>(std::max<int64_t>(half, 1));
+        for (size_t i = 0; i < n; ++i) {
+            a.data()[i] = state.sum_even.data()[i] * inv_half;
+            b.data()[i] = (sum.data()[i] - state.sum_even.data()[i]) * inv_half;
+        }
+        noise = HdrFlip(a, b).mean;
+        if (request.show_progress) {
+            std::fprintf(stderr, "%s: %lld paths per pixel, noise %.4f (target %.4f)\n",
+                         model.Info().name.c_str(), static_cast<long long>(samples_done), noise,
+                         mc.noise_target);
+        }
+        const double predicted =
+            noise > 0.0 ? samples_done * std::pow(noise / mc.noise_target, 1.0 / 0.45) : 0.0;
+        next_check = static_cast<int64_t>(
+            std::clamp(1.05 * predicted, 1.3 * samples_done, 3.0 * samples_done));
+        return noise <= mc.noise_target;
+    };
+    bool reached = false;
+    if (noise_mode && passes_done >= 2) reached = measure_noise();
+    for (int64_t p = passes_done; p < passes && !reached; ++p) {
         MonteCarloPass pass;
         pass.seed = mc.seed;
         pass.first_sample = p * pass_spp;
-        pass.samples = std::min(pass_spp, spp - pass.first_sample);
+        pass.samples = noise_mode ? pass_spp : std::min(pass_spp, spp - pass.first_sample);
         model.RenderPass(request, pass, &pass_image, &progress);
         // Weighted by the pass's sample count so a short last pass counts right.
         const float wgt = static_cast<float>(pass.samples);
@@ -343,13 +396,19 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
             const float v = pass_image.data()[i];
             sum.data()[i] += wgt * v;
             sum_sq.data()[i] += wgt * v * v;
+            if (noise_mode && p % 2 == 0) state.sum_even.data()[i] += wgt * v;
         }
         ++passes_done;
         samples_done += pass.samples;
+        const bool pair_done = !noise_mode || p % 2 == 1;
+        if (noise_mode && pair_done && (samples_done >= next_check || p + 1 == passes)) {
+            reached = measure_noise();
+        }
         const auto now = std::chrono::steady_clock::now();
         const int signal_number = stop.Received();
-        if (signal_number != 0 || std::chrono::duration<double>(now - last_save).count() > 10.0 ||
-            p + 1 == passes) {
+        if (signal_number != 0 ||
+            (pair_done && (std::chrono::duration<double>(now - last_save).count() > 10.0 ||
+                           p + 1 == passes || reached))) {
             save_checkpoint();
             last_save = now;
         }
@@ -361,12 +420,16 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
                 throw;
             }
         }
-        if (signal_number != 0 && p + 1 < passes) {
+        if (signal_number != 0 && p + 1 < passes && !reached) {
             Fail("interrupted by ", signal_number == SIGINT ? "SIGINT" : "SIGTERM", " after pass ",
                  passes_done, " of ", passes, " (", samples_done, " of ", spp,
                  " samples per pixel); the checkpoint '", path,
                  "' holds them: the same command with --resume continues");
         }
+    }
+    if (request.report) {
+        request.report->samples = samples_done;
+        request.report->noise = noise;
     }
     // Mean, and the variance of the mean from the pass means (batch means):
     // Var(mean) = (E[v^2] - mean^2) / (passes - 1), weights by sample count.

@@ -21,7 +21,8 @@
 
 namespace atmos {
 
-// Paths per pass: mc.pass_spp, or (0) spp / 8 clamped to [1, 64].
+// Paths per pass: mc.pass_spp, or (0) spp / 8 clamped to [1, 64] (with a noise
+// target: spp / 2 clamped to [1, 16], the passes alternating between the halves).
 int64_t PassSpp(const MonteCarloSettings& mc);
 
 // The settings of `--spp`, `--seed` and `--pass-spp` (the flags' names are
