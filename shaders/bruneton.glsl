@@ -310,6 +310,46 @@ vec3 atmos_SkyRadiance(vec3 camera, vec3 view_ray, float shadow_length, vec3 sun
 // BrunetonLut::SkyRadianceToPoint (seed 004 GetSkyRadianceToPoint): the
 // scattering between camera and point (aerial perspective) as the difference
 // of two lookups; the transmittance between them in `transmittance`.
+// GetLayerDensity / GetProfileDensity (physics/density.h; seed 004): a layer is
+// vec4(exp_term, exp_scale, linear_term, constant_term); a zero exp_term has no
+// exponential (0 * exp(large) would be NaN).
+float atmos_LayerDensity(vec4 l, float altitude) {
+    float e = l.x != 0.0 ? l.x * exp(l.y * altitude) : 0.0;
+    return clamp(e + l.z * altitude + l.w, 0.0, 1.0);
+}
+float atmos_ProfileDensity(float width0, vec4 l0, vec4 l1, float altitude) {
+    return altitude < width0 ? atmos_LayerDensity(l0, altitude) : atmos_LayerDensity(l1, altitude);
+}
+
+// BrunetonLut::SegmentSingleMie (issue 15): single Mie scattering without the
+// phase function between the camera at (r, mu, mu_s, nu) and the point at
+// distance d, by the midpoint rule in ATMOS_LOW_SUN_MIE_STEPS samples; the view
+// transmittance from the extinction accumulated along the segment, the sun's
+// from the table.
+vec3 atmos_SegmentSingleMie(float r, float mu, float mu_s, float nu, float d) {
+    int n = ATMOS_LOW_SUN_MIE_STEPS;
+    float dt = d / float(n);
+    vec3 tau = vec3(0.0);
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < n; ++i) {
+        float t = (float(i) + 0.5) * dt;
+        float r_t = atmos_ClampRadius(sqrt(t * t + 2.0 * r * mu * t + r * r));
+        float alt = r_t - ATMOS_BOTTOM_RADIUS;
+        float d_r = atmos_ProfileDensity(ATMOS_RAYLEIGH_WIDTH0, ATMOS_RAYLEIGH_LAYER0,
+                                         ATMOS_RAYLEIGH_LAYER1, alt);
+        float d_m = atmos_ProfileDensity(ATMOS_MIE_WIDTH0, ATMOS_MIE_LAYER0, ATMOS_MIE_LAYER1, alt);
+        float d_a = atmos_ProfileDensity(ATMOS_ABSORPTION_WIDTH0, ATMOS_ABSORPTION_LAYER0,
+                                         ATMOS_ABSORPTION_LAYER1, alt);
+        vec3 ext = ATMOS_RAYLEIGH_SCATTERING * d_r + ATMOS_MIE_EXTINCTION * d_m +
+                   ATMOS_ABSORPTION_EXTINCTION * d_a;
+        vec3 tau_mid = tau + ext * (0.5 * dt);
+        tau += ext * dt;
+        vec3 ts = atmos_TransmittanceToSun(r_t, atmos_ClampCosine((r * mu_s + t * nu) / r_t));
+        sum += ts * exp(-tau_mid) * (d_m * dt);
+    }
+    return sum * ATMOS_MIE_SCATTERING;
+}
+
 vec3 atmos_SkyRadianceToPoint(vec3 camera, vec3 point, float shadow_length, vec3 sun_direction,
                               bool ray_hits_ground, out vec3 transmittance) {
     vec3 view_ray = normalize(point - camera);
@@ -345,8 +385,18 @@ vec3 atmos_SkyRadianceToPoint(vec3 camera, vec3 point, float shadow_length, vec3
 #if ATMOS_COMBINED_MIE
     single_mie = atmos_ExtrapolatedSingleMie(vec4(scattering, single_mie.r));
 #endif
-    // Seed 004's hack against artefacts with the sun below the horizon.
-    single_mie *= atmos_SmoothStep(0.0, 0.01, mu_s);
+    // Seed 004 fades single Mie out below mu_s = 0.01 (its hack against the
+    // lookups' difference artefacts); by default (ATMOS_LOW_SUN_MIE 0) the
+    // faded part is the single Mie integral along the segment (issue 15).
+    float fade = atmos_SmoothStep(0.0, 0.01, mu_s);
+#if ATMOS_LOW_SUN_MIE != 2
+    if (fade < 1.0) {
+        single_mie *= fade;
+#if ATMOS_LOW_SUN_MIE == 0
+        single_mie += atmos_SegmentSingleMie(r, mu, mu_s, nu, d) * (1.0 - fade);
+#endif
+    }
+#endif
     return max(scattering, vec3(0.0)) * atmos_RayleighPhase(nu) +
            max(single_mie, vec3(0.0)) * atmos_MiePhase(nu);
 }

@@ -69,7 +69,11 @@ TEST(Reliability, GroundBelowACameraAtAltitudeZeroIsLit) {
     for (const ModelInfo& info : ListModels()) {
         // reference: fixed by its own change (issue 18, path tracer); preetham
         // and the transmittance models produce no ground at all.
-        if (info.name == "reference" || info.name == "preetham" || !info.capabilities.radiance) {
+        // neural: its shipped weights were fitted at albedo 0 and refuse this
+        // atmosphere (issue 15, Neural.WeightsCheckCoversEveryFieldTheFitDependsOn);
+        // its evaluator calls the same GroundAtCamera as the others.
+        if (info.name == "reference" || info.name == "preetham" || info.name == "neural" ||
+            !info.capabilities.radiance) {
             continue;
         }
         SCOPED_TRACE(info.name);
