@@ -27,7 +27,7 @@ constexpr int kDefaultReferenceSpp = 64;
 // The main job's default: a noise target (HDR-FLIP between the reference's
 // halves), capped at kDefaultReferenceCap paths per pixel.
 constexpr double kDefaultReferenceNoise = 0.01;
-constexpr int kDefaultReferenceCap = 1024;
+constexpr int kDefaultReferenceCap = 512;
 
 struct CompareCliOptions {
     std::vector<std::string> models, views, sets;
@@ -164,7 +164,7 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
         cmd->add_option("--reference-noise", o->reference_noise,
                         "noise target of a Monte Carlo reference: each view renders until the "
                         "HDR-FLIP between its two halves (even and odd passes) is at or below it, "
-                        "at most --reference-spp paths per pixel (default then 1024); 0, or "
+                        "at most --reference-spp paths per pixel (default then 512); 0, or "
                         "--reference-spp given alone: a fixed --reference-spp (two halves of "
                         "spp/2, seeds 2s+1 and 2s+2)")
             ->capture_default_str();
