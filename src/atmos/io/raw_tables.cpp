@@ -4,6 +4,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 
 #include "atmos/error.h"
 
@@ -103,6 +104,20 @@ nlohmann::ordered_json WriteRawTables(const std::string& directory,
     j["float16"] = {{"file", "tables.f16"}, {"bytes", f16.size()}};
     j["tables"] = list;
     return j;
+}
+
+void WriteGlslDensityProfiles(std::ostream& s, const AtmosphereParameters& a) {
+    auto profile = [&](const char* name, const DensityProfile& p) {
+        s << "#define ATMOS_" << name << "_WIDTH0 " << p.layers[0].width << "\n";
+        for (int i = 0; i < 2; ++i) {
+            const DensityProfileLayer& l = p.layers[i];
+            s << "#define ATMOS_" << name << "_LAYER" << i << " vec4(" << l.exp_term << ", "
+              << l.exp_scale << ", " << l.linear_term << ", " << l.constant_term << ")\n";
+        }
+    };
+    profile("RAYLEIGH", a.rayleigh_density);
+    profile("MIE", a.mie_density);
+    profile("ABSORPTION", a.absorption_density);
 }
 
 }  // namespace atmos

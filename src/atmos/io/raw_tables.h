@@ -11,10 +11,12 @@
 #pragma once
 
 #include <cstdint>
+#include <iosfwd>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "atmos/atmosphere.h"
 #include "base/texture.h"
 
 namespace atmos {
@@ -32,6 +34,11 @@ nlohmann::ordered_json WriteRawTables(const std::string& directory,
 // IEEE 754 binary16 bits of x: round to nearest even, +-65504 for larger
 // magnitudes (no infinities), subnormals kept, NaN to 0.
 uint16_t FloatToHalf(float x);
+
+// The shaders' density-profile #defines (ATMOS_RAYLEIGH_WIDTH0,
+// ATMOS_RAYLEIGH_LAYER0/1 as vec4(exp_term, exp_scale, linear_term,
+// constant_term), the same for MIE and ABSORPTION) in the stream's format.
+void WriteGlslDensityProfiles(std::ostream& s, const AtmosphereParameters& a);
 float HalfToFloat(uint16_t h);
 
 }  // namespace atmos

@@ -150,17 +150,7 @@ std::string GlslConstants(const AtmosphereParameters& a, const BrunetonConfig& c
     // the density profiles.
     s << "#define ATMOS_MIE_EXTINCTION " << vec3(a.mie_extinction) << "\n";
     s << "#define ATMOS_ABSORPTION_EXTINCTION " << vec3(a.absorption_extinction) << "\n";
-    auto profile = [&](const char* name, const DensityProfile& p) {
-        s << "#define ATMOS_" << name << "_WIDTH0 " << p.layers[0].width << "\n";
-        for (int i = 0; i < 2; ++i) {
-            const DensityProfileLayer& l = p.layers[i];
-            s << "#define ATMOS_" << name << "_LAYER" << i << " vec4(" << l.exp_term << ", "
-              << l.exp_scale << ", " << l.linear_term << ", " << l.constant_term << ")\n";
-        }
-    };
-    profile("RAYLEIGH", a.rayleigh_density);
-    profile("MIE", a.mie_density);
-    profile("ABSORPTION", a.absorption_density);
+    WriteGlslDensityProfiles(s, a);
     s << "#define ATMOS_LOW_SUN_MIE " << c.low_sun_mie << "\n";
     s << "#define ATMOS_LOW_SUN_MIE_STEPS " << c.low_sun_mie_steps << "\n";
     return s.str();
