@@ -14,23 +14,13 @@
 #include <string>
 
 #include "atmos/image.h"
+#include "chromium_util.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-std::string FindChromium() {
-    const char* path = std::getenv("PATH");
-    std::stringstream dirs(path ? path : "/usr/bin:/bin");
-    std::string dir;
-    while (std::getline(dirs, dir, ':')) {
-        for (const char* name : {"chromium", "chromium-browser"}) {
-            const fs::path p = fs::path(dir) / name;
-            if (access(p.c_str(), X_OK) == 0) return p.string();
-        }
-    }
-    return "";
-}
+using atmos::test::FindChromium;
 
 std::string Slurp(const fs::path& p) {
     std::ifstream f(p);
