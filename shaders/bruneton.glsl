@@ -12,7 +12,8 @@
 //      (GLSL ES),
 //   2. DIR/shaders/bruneton_constants.glsl (written by the bake: the
 //      atmosphere's radii, Mie g, scattering coefficients, table sizes),
-//   3. this file,
+//   3. DIR/shaders/common.glsl (the shared math and geometry),
+//   4. this file,
 // then bind the tables (DIR/tables.f32 or .f16, offsets in DIR/bruneton.json
 // "raw") as textures with LINEAR filtering and CLAMP_TO_EDGE wrapping:
 //   atmos_transmittance_texture  2D  RGB  transmittance.exr
@@ -38,14 +39,8 @@ uniform highp sampler3D atmos_scattering_texture;
 uniform highp sampler3D atmos_single_mie_texture;
 #endif
 
-const float ATMOS_PI = 3.14159265358979;
+// ---- geometry (BrunetonLut; the shared helpers are in common.glsl) ----
 
-// ---- math and geometry (include/atmos/math.h, src/atmos/physics/geometry.h) ----
-
-// SafeSqrt.
-float atmos_SafeSqrt(float x) { return sqrt(max(x, 0.0)); }
-// ClampCosine.
-float atmos_ClampCosine(float mu) { return clamp(mu, -1.0, 1.0); }
 // BrunetonLut::ClampRadius (seed 004 ClampRadius).
 float atmos_ClampRadius(float r) { return clamp(r, ATMOS_BOTTOM_RADIUS, ATMOS_TOP_RADIUS); }
 // BrunetonLut::HorizonH: distance to the top for a horizontal ray on the ground.
@@ -56,79 +51,15 @@ float atmos_HorizonH() {
 float atmos_Rho(float r) {
     return atmos_SafeSqrt((r - ATMOS_BOTTOM_RADIUS) * (r + ATMOS_BOTTOM_RADIUS));
 }
-// DistanceToTopAtmosphereBoundary (seed 004 section "Distance to the top
-// atmosphere boundary"): discriminant r^2 (mu^2 - 1) + top^2.
-float atmos_DistanceToTop(float r, float mu) {
-    float disc = (ATMOS_TOP_RADIUS - r) * (ATMOS_TOP_RADIUS + r) + (r * mu) * (r * mu);
-    return max(-r * mu + atmos_SafeSqrt(disc), 0.0);
-}
 // DistanceToBottomAtmosphereBoundary (seed 004, same section).
 float atmos_DistanceToBottom(float r, float mu) {
     float disc = (ATMOS_BOTTOM_RADIUS - r) * (ATMOS_BOTTOM_RADIUS + r) + (r * mu) * (r * mu);
     return max(-r * mu - atmos_SafeSqrt(disc), 0.0);
 }
-// GetTextureCoordFromUnitRange (seed 004 "Precomputation"): texel centres.
-float atmos_TextureCoord(float x, float n) { return 0.5 / n + x * (1.0 - 1.0 / n); }
 // SmoothStep (BrunetonLut::SmoothStep).
 float atmos_SmoothStep(float e0, float e1, float x) {
     float t = clamp((x - e0) / (e1 - e0), 0.0, 1.0);
     return t * t * (3.0 - 2.0 * t);
-}
-// RayleighPhase (src/atmos/physics/phase.h; seed 004 RayleighPhaseFunction).
-float atmos_RayleighPhase(float nu) { return 3.0 / (16.0 * ATMOS_PI) * (1.0 + nu * nu); }
-// CornetteShanksPhase (phase.h; seed 004 MiePhaseFunction).
-float atmos_MiePhase(float nu) {
-    float g = ATMOS_MIE_PHASE_G;
-    float k = 3.0 / (8.0 * ATMOS_PI) * (1.0 - g * g) / (2.0 + g * g);
-    float denom = 1.0 + g * g - 2.0 * g * nu;
-    return k * (1.0 + nu * nu) / (denom * sqrt(denom));
-}
-// IntersectSphere (geometry.h): the stable roots t0 <= t1 of |o + t d| = radius.
-bool atmos_IntersectSphere(vec3 o, vec3 d, float radius, out float t0, out float t1) {
-    float b = dot(o, d);
-    float r = length(o);
-    float c = (r - radius) * (r + radius);
-    float disc = b * b - c;
-    t0 = 0.0;
-    t1 = 0.0;
-    if (disc < 0.0) return false;
-    float s = sqrt(disc);
-    float q = -(b + (b >= 0.0 ? s : -s));
-    float ta = q;
-    float tb = q != 0.0 ? c / q : -b;
-    t0 = min(ta, tb);
-    t1 = max(ta, tb);
-    return true;
-}
-// ClipToAtmosphere (geometry.h): the part of the ray inside the shell and
-// whether the ground ends it. Returns false when the ray misses the atmosphere.
-bool atmos_ClipToAtmosphere(vec3 camera, vec3 dir, out float t_start, out float t_end,
-                            out bool hits_ground) {
-    float top0, top1;
-    t_start = 0.0;
-    t_end = 0.0;
-    hits_ground = false;
-    if (!atmos_IntersectSphere(camera, dir, ATMOS_TOP_RADIUS, top0, top1) || top1 <= 0.0) {
-        return false;
-    }
-    t_start = max(top0, 0.0);
-    t_end = top1;
-    float r = length(camera);
-    if (r <= ATMOS_BOTTOM_RADIUS) {
-        if (dot(camera, dir) < 0.0) {
-            hits_ground = true;
-            t_end = 0.0;
-            return false;
-        }
-    } else {
-        float g0, g1;
-        if (atmos_IntersectSphere(camera, dir, ATMOS_BOTTOM_RADIUS, g0, g1) && g0 > 0.0 &&
-            g0 < t_end) {
-            hits_ground = true;
-            t_end = g0;
-        }
-    }
-    return t_end > t_start;
 }
 
 // ---- transmittance (seed 004 "Transmittance": precomputation and lookup) ----
@@ -307,20 +238,6 @@ vec3 atmos_SkyRadiance(vec3 camera, vec3 view_ray, float shadow_length, vec3 sun
     return scattering * atmos_RayleighPhase(nu) + single_mie * atmos_MiePhase(nu);
 }
 
-// BrunetonLut::SkyRadianceToPoint (seed 004 GetSkyRadianceToPoint): the
-// scattering between camera and point (aerial perspective) as the difference
-// of two lookups; the transmittance between them in `transmittance`.
-// GetLayerDensity / GetProfileDensity (physics/density.h; seed 004): a layer is
-// vec4(exp_term, exp_scale, linear_term, constant_term); a zero exp_term has no
-// exponential (0 * exp(large) would be NaN).
-float atmos_LayerDensity(vec4 l, float altitude) {
-    float e = l.x != 0.0 ? l.x * exp(l.y * altitude) : 0.0;
-    return clamp(e + l.z * altitude + l.w, 0.0, 1.0);
-}
-float atmos_ProfileDensity(float width0, vec4 l0, vec4 l1, float altitude) {
-    return altitude < width0 ? atmos_LayerDensity(l0, altitude) : atmos_LayerDensity(l1, altitude);
-}
-
 // BrunetonLut::SegmentSingleMie (issue 15): single Mie scattering without the
 // phase function between the camera at (r, mu, mu_s, nu) and the point at
 // distance d, by the midpoint rule in ATMOS_LOW_SUN_MIE_STEPS samples; the view
@@ -350,6 +267,9 @@ vec3 atmos_SegmentSingleMie(float r, float mu, float mu_s, float nu, float d) {
     return sum * ATMOS_MIE_SCATTERING;
 }
 
+// BrunetonLut::SkyRadianceToPoint (seed 004 GetSkyRadianceToPoint): the
+// scattering between camera and point (aerial perspective) as the difference
+// of two lookups; the transmittance between them in `transmittance`.
 vec3 atmos_SkyRadianceToPoint(vec3 camera, vec3 point, float shadow_length, vec3 sun_direction,
                               bool ray_hits_ground, out vec3 transmittance) {
     vec3 view_ray = normalize(point - camera);

@@ -9,7 +9,8 @@
 //
 // Use: the #version line and `precision highp float; precision highp
 // sampler3D;` (ES), then DIR/shaders/hillaire_constants.glsl (written by the
-// bake), then this file. Baked tables (DIR/tables.f32 or .f16, "raw" in
+// bake), DIR/shaders/common.glsl (the shared math and geometry), then this
+// file. Baked tables (DIR/tables.f32 or .f16, "raw" in
 // DIR/hillaire.json), LINEAR and CLAMP_TO_EDGE:
 //   atmos_transmittance_texture        2D RGB 256 x 64   transmittance.exr
 //   atmos_multiple_scattering_texture  2D RGB 32 x 32    multiple_scattering.exr
@@ -17,10 +18,12 @@
 // render targets), then the sky:
 //   1. sky-view, 192 x 108: each texel atmos_SkyViewTexel (camera radius and
 //      sun of the frame), into atmos_sky_view_texture;
-//   2. aerial perspective, 32 x 32 x 32: for each slice k, each texel
-//      atmos_AerialPerspectiveTexel into layer k of atmos_ap_scatter_texture
-//      and atmos_ap_transmittance_texture (two draw buffers), with the
-//      frame's camera in the atmos_ap_* uniforms;
+//   2. aerial perspective, 32 x 32 x 32: for each slice k = 0..31, each texel
+//      atmos_AerialPerspectiveStep from slice k - 1's L, T into layer k of
+//      atmos_ap_scatter_texture and atmos_ap_transmittance_texture (and a
+//      32 x 32 copy of L, T for slice k + 1: draw buffers), with the frame's
+//      camera in the atmos_ap_* uniforms (atmos_AerialPerspectiveTexel does a
+//      froxel in one go, without the copies);
 //   3. per pixel atmos_Evaluate (what `atmos render` computes).
 // A camera outside the atmosphere needs neither pass (atmos_Evaluate marches).
 // Units: metres, planet-centred; results per unit solar irradiance.
@@ -38,88 +41,18 @@ uniform vec3 atmos_ap_up;
 uniform float atmos_ap_tan_half_fov_y;
 uniform float atmos_ap_aspect;
 
-const float ATMOS_PI = 3.14159265358979;
 const float ATMOS_SKY_VIEW_WIDTH = 192.0;
 const float ATMOS_SKY_VIEW_HEIGHT = 108.0;
 const int ATMOS_AP_SIZE = 32;
 const int ATMOS_AP_BLEND_SLICE = 24;
 const float ATMOS_SKY_VIEW_MIN_ALTITUDE = 1.0;
 
-// ---- math and geometry (include/atmos/math.h, src/atmos/physics/) ----
+// ---- geometry (the shared helpers are in common.glsl) ----
 
-float atmos_SafeSqrt(float x) { return sqrt(max(x, 0.0)); }
-float atmos_ClampCosine(float mu) { return clamp(mu, -1.0, 1.0); }
-// GetTextureCoordFromUnitRange (seed 004): texel centres.
-float atmos_TextureCoord(float x, float n) { return 0.5 / n + x * (1.0 - 1.0 / n); }
-// RayleighPhase, CornetteShanksPhase (physics/phase.h).
-float atmos_RayleighPhase(float nu) { return 3.0 / (16.0 * ATMOS_PI) * (1.0 + nu * nu); }
-float atmos_MiePhase(float nu) {
-    float g = ATMOS_MIE_PHASE_G;
-    float k = 3.0 / (8.0 * ATMOS_PI) * (1.0 - g * g) / (2.0 + g * g);
-    float denom = 1.0 + g * g - 2.0 * g * nu;
-    return k * (1.0 + nu * nu) / (denom * sqrt(denom));
-}
-// DistanceToTopAtmosphereBoundary (geometry.h; seed 004).
-float atmos_DistanceToTop(float r, float mu) {
-    float disc = (ATMOS_TOP_RADIUS - r) * (ATMOS_TOP_RADIUS + r) + (r * mu) * (r * mu);
-    return max(-r * mu + atmos_SafeSqrt(disc), 0.0);
-}
 // RayIntersectsGround (geometry.h; seed 004).
 bool atmos_RayIntersectsGround(float r, float mu) {
     return mu < 0.0 &&
            (ATMOS_BOTTOM_RADIUS - r) * (ATMOS_BOTTOM_RADIUS + r) + (r * mu) * (r * mu) >= 0.0;
-}
-// IntersectSphere (geometry.h): stable roots t0 <= t1.
-bool atmos_IntersectSphere(vec3 o, vec3 d, float radius, out float t0, out float t1) {
-    float b = dot(o, d);
-    float r = length(o);
-    float c = (r - radius) * (r + radius);
-    float disc = b * b - c;
-    t0 = 0.0;
-    t1 = 0.0;
-    if (disc < 0.0) return false;
-    float s = sqrt(disc);
-    float q = -(b + (b >= 0.0 ? s : -s));
-    float tb = q != 0.0 ? c / q : -b;
-    t0 = min(q, tb);
-    t1 = max(q, tb);
-    return true;
-}
-// ClipToAtmosphere (geometry.h): the segment inside the shell; false when empty.
-bool atmos_ClipToAtmosphere(vec3 camera, vec3 dir, out float t_start, out float t_end,
-                            out bool hits_ground) {
-    float top0, top1;
-    t_start = 0.0;
-    t_end = 0.0;
-    hits_ground = false;
-    if (!atmos_IntersectSphere(camera, dir, ATMOS_TOP_RADIUS, top0, top1) || top1 <= 0.0) {
-        return false;
-    }
-    t_start = max(top0, 0.0);
-    t_end = top1;
-    if (length(camera) <= ATMOS_BOTTOM_RADIUS) {
-        if (dot(camera, dir) < 0.0) {
-            hits_ground = true;
-            t_end = 0.0;
-            return false;
-        }
-    } else {
-        float g0, g1;
-        if (atmos_IntersectSphere(camera, dir, ATMOS_BOTTOM_RADIUS, g0, g1) && g0 > 0.0 &&
-            g0 < t_end) {
-            hits_ground = true;
-            t_end = g0;
-        }
-    }
-    return t_end > t_start;
-}
-// GetLayerDensity / GetProfileDensity (physics/density.h; seed 004): a layer is
-// vec4(exp_term, exp_scale, linear_term, constant_term).
-float atmos_LayerDensity(vec4 l, float altitude) {
-    return clamp(l.x * exp(l.y * altitude) + l.z * altitude + l.w, 0.0, 1.0);
-}
-float atmos_ProfileDensity(float width0, vec4 l0, vec4 l1, float altitude) {
-    return altitude < width0 ? atmos_LayerDensity(l0, altitude) : atmos_LayerDensity(l1, altitude);
 }
 
 // ---- baked tables (paper sections 5.1, 5.5.2) ----
@@ -284,28 +217,34 @@ float atmos_ApSliceDistance(int k) {
     float w = (float(k) + 0.5) / float(ATMOS_AP_SIZE);
     return w * w * float(ATMOS_AP_SIZE) * ATMOS_AP_METRES_PER_SLICE;
 }
-// HillaireAerialPerspectiveStage: froxel (i, j, slice) for the frame's camera
-// at `origin` (atmos_ap_* uniforms): the cumulative march through the slice
-// centres up to `slice`, ATMOS_AP_STEPS_PER_SLICE segments per slice.
-void atmos_AerialPerspectiveTexel(ivec3 froxel, vec3 origin, vec3 sun, out vec3 L, out vec3 T) {
+// HillaireAerialPerspectiveStage, one slice of its cumulative march: for the
+// frame's camera at `origin` (atmos_ap_* uniforms), continues L, T of froxel
+// (i, j, slice - 1) (L = 0, T = 1 before slice 0) through the segment between
+// the centres of slices slice - 1 and slice, ATMOS_AP_STEPS_PER_SLICE segments.
+// One pass per slice, each reading the previous slice's L, T, marches every
+// column once, as the C++ does.
+void atmos_AerialPerspectiveStep(ivec3 froxel, vec3 origin, vec3 sun, inout vec3 L,
+                                 inout vec3 T) {
     float u = (float(froxel.x) + 0.5) / float(ATMOS_AP_SIZE);
     float v = (float(froxel.y) + 0.5) / float(ATMOS_AP_SIZE);
     float tan_y = atmos_ap_tan_half_fov_y;
     vec3 dir = normalize(atmos_ap_forward + atmos_ap_right * ((2.0 * u - 1.0) * tan_y * atmos_ap_aspect) +
                          atmos_ap_up * ((1.0 - 2.0 * v) * tan_y));
     float t_in, t_out;
-    bool crosses = atmos_IntersectSphere(origin, dir, ATMOS_TOP_RADIUS, t_in, t_out) && t_out > 0.0;
+    if (!atmos_IntersectSphere(origin, dir, ATMOS_TOP_RADIUS, t_in, t_out) || t_out <= 0.0) return;
     t_in = max(t_in, 0.0);
+    float t_prev = froxel.z > 0 ? atmos_ApSliceDistance(froxel.z - 1) : 0.0;
+    float t_k = atmos_ApSliceDistance(froxel.z);
+    atmos_Integrate(origin, dir, sun, clamp(t_prev, t_in, t_out), clamp(t_k, t_in, t_out),
+                    ATMOS_AP_STEPS_PER_SLICE, L, T, true);
+}
+// HillaireAerialPerspectiveStage: froxel (i, j, slice) in one go, the steps of
+// slices 0 to `slice` (for a renderer without the per-slice passes).
+void atmos_AerialPerspectiveTexel(ivec3 froxel, vec3 origin, vec3 sun, out vec3 L, out vec3 T) {
     L = vec3(0.0);
     T = vec3(1.0);
-    float t_prev = 0.0;
     for (int k = 0; k <= froxel.z; ++k) {
-        float t_k = atmos_ApSliceDistance(k);
-        if (crosses) {
-            atmos_Integrate(origin, dir, sun, clamp(t_prev, t_in, t_out), clamp(t_k, t_in, t_out),
-                            ATMOS_AP_STEPS_PER_SLICE, L, T, true);
-        }
-        t_prev = t_k;
+        atmos_AerialPerspectiveStep(ivec3(froxel.xy, k), origin, sun, L, T);
     }
 }
 // HillaireEvaluator::AerialPerspective: the volume's lookup at distance d

@@ -136,6 +136,13 @@ TEST(Cli, BakeWritesRawTablesAndShaders) {
     const std::string constants = Slurp(dir / "shaders" / "bruneton_constants.glsl");
     EXPECT_NE(constants.find("#define ATMOS_SCATTERING_MU 8\n"), std::string::npos);
     EXPECT_NE(constants.find("#define ATMOS_COMBINED_MIE 0\n"), std::string::npos);
+    // The shared helpers (GLSL has no #include): installed, and listed in the
+    // order a program concatenates them.
+    EXPECT_NE(Slurp(dir / "shaders" / "common.glsl").find("bool atmos_ClipToAtmosphere("),
+              std::string::npos);
+    EXPECT_EQ(j.at("shaders").at("order"),
+              nlohmann::json({"shaders/bruneton_constants.glsl", "shaders/common.glsl",
+                              "shaders/bruneton.glsl"}));
 }
 
 TEST(Cli, SampleFollowsTheContract) {

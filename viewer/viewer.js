@@ -160,8 +160,8 @@ function compile(gl, type, source) {
   return s;
 }
 
-// One model: its program (GLSL ES header + the bake's constants + the model's
-// functions + MAIN_SHADER) and its textures.
+// One model: its program (GLSL ES header + the bake's constants + common.glsl
+// and the model's functions + MAIN_SHADER) and its textures.
 function makeModel(gl, name, format) {
   var data = atmosViewerData.models[name];
   var blobText = atmosViewerData.tables[name + '/' + format];
@@ -185,7 +185,9 @@ function makeModel(gl, name, format) {
                ['atmos_scattering_texture', 'scattering'],
                ['atmos_single_mie_texture', 'single_mie_scattering']],
     hillaire: [['atmos_transmittance_texture', 'transmittance'],
-               ['atmos_multiple_scattering_texture', 'multiple_scattering']]}[name];
+               ['atmos_multiple_scattering_texture', 'multiple_scattering']],
+    'atmosphere-plus': [['atmos_scattering_texture', 'scattering'],
+                        ['atmos_transmittance_texture', 'transmittance']]}[name];
   var textures = [];
   gl.useProgram(program);
   samplers.forEach(function (s) {
@@ -203,7 +205,8 @@ function makeModel(gl, name, format) {
 
 // Hillaire's per-frame tables (hillaire.glsl, passes 1 and 2): the sky-view
 // table (192 x 108) and the aerial-perspective volume (32^3, in-scatter and
-// transmittance), float render targets sampled by the main pass.
+// transmittance, one pass per slice marching on from the previous slice),
+// float render targets sampled by the main pass.
 var SKY_VIEW_MAIN = [
   'uniform float u_r;',
   'uniform vec3 u_sun;',
@@ -211,17 +214,31 @@ var SKY_VIEW_MAIN = [
   'void main() {',
   '  frag_color = vec4(atmos_SkyViewTexel(ivec2(gl_FragCoord.xy), u_r, u_sun), 1.0);',
   '}'].join('\n');
+// One slice of the aerial-perspective volume: froxel (x, y, u_slice) continues
+// slice u_slice - 1's L, T (a 32 x 32 copy of the previous slice, ping-pong)
+// and writes the volume's layer and the copy for the next slice.
 var AP_MAIN = [
   'uniform int u_slice;',
   'uniform vec3 u_camera;',
   'uniform vec3 u_sun;',
+  'uniform highp sampler2D u_prev_scatter;',
+  'uniform highp sampler2D u_prev_transmittance;',
   'layout(location = 0) out vec4 frag_scatter;',
   'layout(location = 1) out vec4 frag_transmittance;',
+  'layout(location = 2) out vec4 next_scatter;',
+  'layout(location = 3) out vec4 next_transmittance;',
   'void main() {',
-  '  vec3 L, T;',
-  '  atmos_AerialPerspectiveTexel(ivec3(ivec2(gl_FragCoord.xy), u_slice), u_camera, u_sun, L, T);',
+  '  ivec2 p = ivec2(gl_FragCoord.xy);',
+  '  vec3 L = vec3(0.0), T = vec3(1.0);',
+  '  if (u_slice > 0) {',
+  '    L = texelFetch(u_prev_scatter, p, 0).rgb;',
+  '    T = texelFetch(u_prev_transmittance, p, 0).rgb;',
+  '  }',
+  '  atmos_AerialPerspectiveStep(ivec3(p, u_slice), u_camera, u_sun, L, T);',
   '  frag_scatter = vec4(L, 1.0);',
   '  frag_transmittance = vec4(T, 1.0);',
+  '  next_scatter = frag_scatter;',
+  '  next_transmittance = frag_transmittance;',
   '}'].join('\n');
 
 function linkProgram(gl, fragment) {
@@ -266,14 +283,20 @@ function makeHillaireFrame(gl, model, base) {
     gl.uniform1i(gl.getUniformLocation(model.program, u[0]), model.textures.length);
     model.textures.push(u[1]);
   });
+  // Ping-pong copies of one slice's L and T for the next slice.
+  var state = [0, 1].map(function () {
+    return [makeTarget(gl, gl.TEXTURE_2D, 32, 32, 1), makeTarget(gl, gl.TEXTURE_2D, 32, 32, 1)];
+  });
   var passes = {sky: linkProgram(gl, base + SKY_VIEW_MAIN), ap: linkProgram(gl, base + AP_MAIN),
-                skyTarget: sky, apScatter: apS, apTransmittance: apT,
+                skyTarget: sky, apScatter: apS, apTransmittance: apT, apState: state,
                 skyFb: gl.createFramebuffer(), apFb: gl.createFramebuffer()};
   [passes.sky, passes.ap].forEach(function (p) {
     gl.useProgram(p);
     gl.uniform1i(gl.getUniformLocation(p, 'atmos_transmittance_texture'), 0);
     gl.uniform1i(gl.getUniformLocation(p, 'atmos_multiple_scattering_texture'), 1);
   });
+  gl.uniform1i(gl.getUniformLocation(passes.ap, 'u_prev_scatter'), 2);
+  gl.uniform1i(gl.getUniformLocation(passes.ap, 'u_prev_transmittance'), 3);
   gl.bindFramebuffer(gl.FRAMEBUFFER, passes.skyFb);
   gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, sky.texture, 0);
   model.hillaire = passes;
@@ -314,12 +337,22 @@ function buildHillaireFrame(gl, model, view, aspect) {
   gl.uniform3fv(gl.getUniformLocation(h.ap, 'u_camera'), pos);
   gl.uniform3fv(gl.getUniformLocation(h.ap, 'u_sun'), sun);
   gl.bindFramebuffer(gl.FRAMEBUFFER, h.apFb);
-  gl.drawBuffers([gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1]);
+  gl.drawBuffers([gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1, gl.COLOR_ATTACHMENT2,
+                  gl.COLOR_ATTACHMENT3]);
   gl.viewport(0, 0, 32, 32);
   for (var k = 0; k < 32; ++k) {
+    var prev = h.apState[(k + 1) % 2], next = h.apState[k % 2];
     gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, h.apScatter.texture, 0, k);
     gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, h.apTransmittance.texture,
                                0, k);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT2, gl.TEXTURE_2D,
+                            next[0].texture, 0);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT3, gl.TEXTURE_2D,
+                            next[1].texture, 0);
+    gl.activeTexture(gl.TEXTURE2);
+    gl.bindTexture(gl.TEXTURE_2D, prev[0].texture);
+    gl.activeTexture(gl.TEXTURE3);
+    gl.bindTexture(gl.TEXTURE_2D, prev[1].texture);
     gl.uniform1i(gl.getUniformLocation(h.ap, 'u_slice'), k);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
   }

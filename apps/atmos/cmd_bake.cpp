@@ -1,6 +1,7 @@
 // atmos CLI: `atmos bake`: a model's precomputed tables as files for other
 // engines (EXR, raw float32/float16, JSON) with the GLSL that reads them; and
-// `atmos viewer`: those, for the models with shaders, in a WebGL2 page.
+// `atmos viewer`: those, for the models with shaders (bruneton, hillaire,
+// atmosphere-plus), in a WebGL2 page.
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -31,6 +32,10 @@ std::string ShaderAsset(const std::string& model) {
     return "shaders/" + file + ".glsl";
 }
 
+// The math and geometry every model's shader uses (GLSL has no #include: a
+// program concatenates the constants, this, and the model's file).
+constexpr const char* kCommonShader = "shaders/common.glsl";
+
 void WriteText(const fs::path& path, const std::string& text) {
     std::ofstream out(path, std::ios::binary);
     out << text;
@@ -60,6 +65,7 @@ std::string BakeInto(const CommonOptions& common, const std::string& dir) {
     if (const char* shader = FindAsset(ShaderAsset(spec.name))) {
         fs::create_directories(fs::path(dir) / "shaders");
         WriteText(fs::path(dir) / ShaderAsset(spec.name), shader);
+        WriteText(fs::path(dir) / kCommonShader, FindAsset(kCommonShader));
     }
     if (!common.quiet) {
         std::fprintf(stderr, "baked %s (precomputed in %.3f s) into %s\n", common.model.c_str(),
@@ -119,12 +125,13 @@ std::string Base64(const std::string& bytes) {
     return out;
 }
 
-// The page's view of one baked model: MODEL/model.js (its JSON and shaders)
+// The page's view of one baked model: MODEL/model.js (its JSON, constants and
+// functions: common.glsl then the model's shader)
 // and MODEL/tables_f32.js, MODEL/tables_f16.js (the raw blobs in base64):
 // scripts, so that the page works from file:// where fetch() is refused.
 void WriteViewerData(const fs::path& dir, const std::string& name) {
     const std::string json = ReadFile(dir / (name + ".json"));
-    const std::string functions = ReadFile(dir / ShaderAsset(name));
+    const std::string functions = ReadFile(dir / kCommonShader) + ReadFile(dir / ShaderAsset(name));
     std::string file = name;
     for (char& c : file) {
         if (c == '-') c = '_';
@@ -141,18 +148,27 @@ void WriteViewerData(const fs::path& dir, const std::string& name) {
     }
 }
 
+// A command that bakes into an output directory: the common options and
+// -o/--output (`bake` and `viewer`).
+Command AddOutputCommand(CLI::App* root, const char* name, const char* description,
+                         CommonOptions* common, std::string* output) {
+    Command c;
+    c.app = root->add_subcommand(name, description);
+    AddCommonOptions(c.app, common);
+    c.app->add_option("-o,--output", *output, "output directory")->required();
+    return c;
+}
+
 }  // namespace
 
 Command AddBakeCommand(CLI::App* root) {
     auto common = std::make_shared<CommonOptions>();
     auto output = std::make_shared<std::string>();
-    Command c;
-    c.app = root->add_subcommand(
-        "bake",
+    Command c = AddOutputCommand(
+        root, "bake",
         "precompute a model's lookup tables and write them (EXR, raw float32/float16, JSON) and "
-        "the GLSL that reads them (DIR/shaders/) to a directory");
-    AddCommonOptions(c.app, common.get());
-    c.app->add_option("-o,--output", *output, "output directory")->required();
+        "the GLSL that reads them (DIR/shaders/) to a directory",
+        common.get(), output.get());
     c.run = [common, output] {
         BakeInto(*common, *output);
         return 0;
@@ -164,17 +180,16 @@ Command AddViewerCommand(CLI::App* root) {
     auto common = std::make_shared<CommonOptions>();
     auto output = std::make_shared<std::string>();
     auto models = std::make_shared<std::vector<std::string>>();
-    Command c;
-    c.app = root->add_subcommand(
-        "viewer",
+    Command c = AddOutputCommand(
+        root, "viewer",
         "bake the models with shaders and write a self-contained WebGL2 sky viewer (open "
-        "DIR/index.html; no network)");
-    AddCommonOptions(c.app, common.get());
-    c.app->add_option("-o,--output", *output, "output directory")->required();
+        "DIR/index.html; no network)",
+        common.get(), output.get());
     c.app
         ->add_option("--models", *models,
                      "models to bake, NAME[:OPTION=VALUE...] comma-separated (default: "
-                     "bruneton); with --load DIR, one model read from DIR")
+                     "bruneton,hillaire,atmosphere-plus); with --load DIR, one model read "
+                     "from DIR")
         ->delimiter(',');
     CLI::Option* model_flag = c.app->get_option("--model");
     c.run = [common, output, models, model_flag] {
@@ -183,7 +198,7 @@ Command AddViewerCommand(CLI::App* root) {
             if (!specs.empty()) Fail("give --models or --model, not both");
             specs.push_back(common->model);  // --model: one model, as for bake
         }
-        if (specs.empty()) specs = {"bruneton", "hillaire"};
+        if (specs.empty()) specs = {"bruneton", "hillaire", "atmosphere-plus"};
         if (!common->load.empty() && specs.size() != 1) {
             Fail("--load reads one model's tables: give one model in --models");
         }
@@ -197,7 +212,7 @@ Command AddViewerCommand(CLI::App* root) {
             const std::string name = ParseModelSpec(spec).name;
             if (!FindAsset(ShaderAsset(name))) {
                 Fail("model ", name, " has no shaders (", ShaderAsset(name),
-                     "): the viewer shows bruneton and hillaire");
+                     "): the viewer shows bruneton, hillaire and atmosphere-plus");
             }
             BakeInto(one, (dir / name).string());
             WriteViewerData(dir / name, name);

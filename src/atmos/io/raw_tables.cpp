@@ -106,7 +106,23 @@ nlohmann::ordered_json WriteRawTables(const std::string& directory,
     return j;
 }
 
-void WriteGlslDensityProfiles(std::ostream& s, const AtmosphereParameters& a) {
+void WriteGlslAtmosphere(std::ostream& s, const AtmosphereParameters& a) {
+    const std::ios_base::fmtflags flags = s.flags();
+    const std::streamsize precision = s.precision(9);
+    s << std::scientific;
+    auto vec3 = [&](const char* name, const Vec3d& v) {
+        s << "#define " << name << " vec3(" << v.x << ", " << v.y << ", " << v.z << ")\n";
+    };
+    s << "#define ATMOS_BOTTOM_RADIUS " << a.bottom_radius << "\n";
+    s << "#define ATMOS_TOP_RADIUS " << a.top_radius << "\n";
+    s << "#define ATMOS_MIE_PHASE_G " << a.mie_phase_g << "\n";
+    s << "#define ATMOS_SUN_ANGULAR_RADIUS " << a.sun_angular_radius << "\n";
+    vec3("ATMOS_RAYLEIGH_SCATTERING", a.rayleigh_scattering);
+    vec3("ATMOS_MIE_SCATTERING", a.mie_scattering);
+    vec3("ATMOS_MIE_EXTINCTION", a.mie_extinction);
+    vec3("ATMOS_ABSORPTION_EXTINCTION", a.absorption_extinction);
+    vec3("ATMOS_GROUND_ALBEDO", a.ground_albedo);
+    vec3("ATMOS_SOLAR_IRRADIANCE", a.solar_irradiance);
     auto profile = [&](const char* name, const DensityProfile& p) {
         s << "#define ATMOS_" << name << "_WIDTH0 " << p.layers[0].width << "\n";
         for (int i = 0; i < 2; ++i) {
@@ -118,6 +134,27 @@ void WriteGlslDensityProfiles(std::ostream& s, const AtmosphereParameters& a) {
     profile("RAYLEIGH", a.rayleigh_density);
     profile("MIE", a.mie_density);
     profile("ABSORPTION", a.absorption_density);
+    s.flags(flags);
+    s.precision(precision);
+}
+
+nlohmann::ordered_json WriteGlslConstants(const std::string& directory, const std::string& stem,
+                                          const std::string& text) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::path(directory) / "shaders";
+    fs::create_directories(dir);
+    const std::string constants = "shaders/" + stem + "_constants.glsl";
+    const std::string path = (fs::path(directory) / constants).string();
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    if (!out) Fail("cannot write '", path, "'");
+    const std::string functions = "shaders/" + stem + ".glsl";
+    nlohmann::ordered_json j;
+    j["constants"] = constants;
+    j["common"] = "shaders/common.glsl";
+    j["functions"] = functions;
+    j["order"] = {constants, "shaders/common.glsl", functions};
+    return j;
 }
 
 }  // namespace atmos

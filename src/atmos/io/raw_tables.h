@@ -35,10 +35,22 @@ nlohmann::ordered_json WriteRawTables(const std::string& directory,
 // magnitudes (no infinities), subnormals kept, NaN to 0.
 uint16_t FloatToHalf(float x);
 
-// The shaders' density-profile #defines (ATMOS_RAYLEIGH_WIDTH0,
-// ATMOS_RAYLEIGH_LAYER0/1 as vec4(exp_term, exp_scale, linear_term,
-// constant_term), the same for MIE and ABSORPTION) in the stream's format.
-void WriteGlslDensityProfiles(std::ostream& s, const AtmosphereParameters& a);
+// The shaders' atmosphere #defines (shaders/common.glsl and every model's
+// shader read them), in scientific notation with 9 digits: ATMOS_BOTTOM_RADIUS,
+// ATMOS_TOP_RADIUS, ATMOS_MIE_PHASE_G, ATMOS_SUN_ANGULAR_RADIUS, the vec3s
+// ATMOS_RAYLEIGH_SCATTERING, ATMOS_MIE_SCATTERING, ATMOS_MIE_EXTINCTION,
+// ATMOS_ABSORPTION_EXTINCTION, ATMOS_GROUND_ALBEDO, ATMOS_SOLAR_IRRADIANCE, and
+// the density profiles (ATMOS_RAYLEIGH_WIDTH0, ATMOS_RAYLEIGH_LAYER0/1 as
+// vec4(exp_term, exp_scale, linear_term, constant_term), the same for MIE and
+// ABSORPTION).
+void WriteGlslAtmosphere(std::ostream& s, const AtmosphereParameters& a);
+
+// Writes DIR/shaders/STEM_constants.glsl (a bake's #defines, `text`) and
+// returns the bake JSON's "shaders": the constants, shaders/common.glsl and
+// shaders/STEM.glsl (installed by `atmos bake`), and "order", the order in
+// which a program concatenates them. Throws atmos::Error when it cannot write.
+nlohmann::ordered_json WriteGlslConstants(const std::string& directory, const std::string& stem,
+                                          const std::string& text);
 float HalfToFloat(uint16_t h);
 
 }  // namespace atmos
