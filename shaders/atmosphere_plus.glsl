@@ -186,13 +186,10 @@ vec3 atmos_AplusGround(vec3 g, vec3 sun) {
 // sees the ground at its feet through no air).
 void atmos_Evaluate(vec3 camera, vec3 dir, vec3 sun, out vec3 sky, out vec3 ground,
                     out vec3 transmittance, out bool hits_ground) {
-    sky = vec3(0.0);
-    ground = vec3(0.0);
-    transmittance = vec3(1.0);
     float t_start, t_end;
-    bool inside = atmos_ClipToAtmosphere(camera, dir, t_start, t_end, hits_ground);
-    vec3 albedo = ATMOS_GROUND_ALBEDO;
-    bool lit_ground = max(albedo.r, max(albedo.g, albedo.b)) > 0.0;
+    bool inside =
+        atmos_BeginRay(camera, dir, sky, ground, transmittance, hits_ground, t_start, t_end);
+    bool lit_ground = atmos_GroundReflects();
     if (!inside) {
         if (hits_ground && lit_ground) ground = atmos_AplusGround(camera, sun);
         return;

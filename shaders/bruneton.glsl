@@ -252,11 +252,8 @@ vec3 atmos_SegmentSingleMie(float r, float mu, float mu_s, float nu, float d) {
         float t = (float(i) + 0.5) * dt;
         float r_t = atmos_ClampRadius(sqrt(t * t + 2.0 * r * mu * t + r * r));
         float alt = r_t - ATMOS_BOTTOM_RADIUS;
-        float d_r = atmos_ProfileDensity(ATMOS_RAYLEIGH_WIDTH0, ATMOS_RAYLEIGH_LAYER0,
-                                         ATMOS_RAYLEIGH_LAYER1, alt);
-        float d_m = atmos_ProfileDensity(ATMOS_MIE_WIDTH0, ATMOS_MIE_LAYER0, ATMOS_MIE_LAYER1, alt);
-        float d_a = atmos_ProfileDensity(ATMOS_ABSORPTION_WIDTH0, ATMOS_ABSORPTION_LAYER0,
-                                         ATMOS_ABSORPTION_LAYER1, alt);
+        vec3 d = atmos_Densities(alt);
+        float d_r = d.x, d_m = d.y, d_a = d.z;
         vec3 ext = ATMOS_RAYLEIGH_SCATTERING * d_r + ATMOS_MIE_EXTINCTION * d_m +
                    ATMOS_ABSORPTION_EXTINCTION * d_a;
         vec3 tau_mid = tau + ext * (0.5 * dt);
@@ -339,11 +336,9 @@ vec3 atmos_SunAndSkyIrradiance(vec3 point, vec3 normal, vec3 sun_direction,
 // transmittance of the ray's segment in the atmosphere.
 void atmos_Evaluate(vec3 camera, vec3 dir, vec3 sun, out vec3 sky, out vec3 ground,
                     out vec3 transmittance, out bool hits_ground) {
-    sky = vec3(0.0);
-    ground = vec3(0.0);
-    transmittance = vec3(1.0);
     float t_start, t_end;
-    bool inside = atmos_ClipToAtmosphere(camera, dir, t_start, t_end, hits_ground);
+    bool inside =
+        atmos_BeginRay(camera, dir, sky, ground, transmittance, hits_ground, t_start, t_end);
     if (!inside && !hits_ground) return;
     if (!hits_ground) {
         sky = atmos_SkyRadiance(camera, dir, 0.0, sun, false, transmittance);
@@ -354,7 +349,7 @@ void atmos_Evaluate(vec3 camera, vec3 dir, vec3 sun, out vec3 sky, out vec3 grou
     if (inside) {
         sky = atmos_SkyRadianceToPoint(camera, ground_point, 0.0, sun, true, transmittance);
     }
-    if (max(ATMOS_GROUND_ALBEDO.r, max(ATMOS_GROUND_ALBEDO.g, ATMOS_GROUND_ALBEDO.b)) > 0.0) {
+    if (atmos_GroundReflects()) {
         vec3 normal = normalize(ground_point);
         vec3 sky_irradiance;
         vec3 sun_irradiance = atmos_SunAndSkyIrradiance(ground_point, normal, sun, sky_irradiance);

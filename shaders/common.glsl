@@ -88,6 +88,20 @@ bool atmos_ClipToAtmosphere(vec3 camera, vec3 dir, out float t_start, out float 
     }
     return t_end > t_start;
 }
+// BeginRay (physics/ray.h): resets a model's outputs (no light, T = 1) and
+// clips the ray to the atmosphere (ClipToAtmosphere's result).
+bool atmos_BeginRay(vec3 camera, vec3 dir, out vec3 sky, out vec3 ground,
+                    out vec3 transmittance, out bool hits_ground, out float t_start,
+                    out float t_end) {
+    sky = vec3(0.0);
+    ground = vec3(0.0);
+    transmittance = vec3(1.0);
+    return atmos_ClipToAtmosphere(camera, dir, t_start, t_end, hits_ground);
+}
+// MaxComponent(ground_albedo) > 0: the evaluators shade the ground only then.
+bool atmos_GroundReflects() {
+    return max(ATMOS_GROUND_ALBEDO.r, max(ATMOS_GROUND_ALBEDO.g, ATMOS_GROUND_ALBEDO.b)) > 0.0;
+}
 // GetLayerDensity / GetProfileDensity (physics/density.h; seed 004): a layer is
 // vec4(exp_term, exp_scale, linear_term, constant_term); a zero exp_term has no
 // exponential (0 * exp(large) would be NaN).
@@ -97,4 +111,14 @@ float atmos_LayerDensity(vec4 l, float altitude) {
 }
 float atmos_ProfileDensity(float width0, vec4 l0, vec4 l1, float altitude) {
     return altitude < width0 ? atmos_LayerDensity(l0, altitude) : atmos_LayerDensity(l1, altitude);
+}
+// GetDensities (physics/density.h): the Rayleigh, Mie and absorption densities
+// at an altitude, as (x, y, z).
+vec3 atmos_Densities(float altitude) {
+    return vec3(atmos_ProfileDensity(ATMOS_RAYLEIGH_WIDTH0, ATMOS_RAYLEIGH_LAYER0,
+                                     ATMOS_RAYLEIGH_LAYER1, altitude),
+                atmos_ProfileDensity(ATMOS_MIE_WIDTH0, ATMOS_MIE_LAYER0, ATMOS_MIE_LAYER1,
+                                     altitude),
+                atmos_ProfileDensity(ATMOS_ABSORPTION_WIDTH0, ATMOS_ABSORPTION_LAYER0,
+                                     ATMOS_ABSORPTION_LAYER1, altitude));
 }

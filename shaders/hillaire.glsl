@@ -116,11 +116,8 @@ void atmos_Integrate(vec3 origin, vec3 dir, vec3 sun, float ta, float tb, int n,
         }
         float mu_s = atmos_ClampCosine(dot(p, sun) / r);
         float alt = r - ATMOS_BOTTOM_RADIUS;
-        float d_r = atmos_ProfileDensity(ATMOS_RAYLEIGH_WIDTH0, ATMOS_RAYLEIGH_LAYER0,
-                                         ATMOS_RAYLEIGH_LAYER1, alt);
-        float d_m = atmos_ProfileDensity(ATMOS_MIE_WIDTH0, ATMOS_MIE_LAYER0, ATMOS_MIE_LAYER1, alt);
-        float d_a = atmos_ProfileDensity(ATMOS_ABSORPTION_WIDTH0, ATMOS_ABSORPTION_LAYER0,
-                                         ATMOS_ABSORPTION_LAYER1, alt);
+        vec3 d = atmos_Densities(alt);
+        float d_r = d.x, d_m = d.y, d_a = d.z;
         vec3 sigma_r = ATMOS_RAYLEIGH_SCATTERING * d_r;
         vec3 sigma_m = ATMOS_MIE_SCATTERING * d_m;
         vec3 sigma_t = ATMOS_RAYLEIGH_SCATTERING * d_r + ATMOS_MIE_EXTINCTION * d_m +
@@ -279,11 +276,10 @@ bool atmos_AerialPerspective(vec3 dir, float d, out vec3 scatter, out vec3 trans
 // it marches ATMOS_STEPS segments.
 void atmos_Evaluate(vec3 camera, vec3 dir, vec3 sun, out vec3 sky, out vec3 ground,
                     out vec3 transmittance, out bool hits_ground) {
-    sky = vec3(0.0);
-    ground = vec3(0.0);
-    transmittance = vec3(1.0);
     float t_start, t_end;
-    if (!atmos_ClipToAtmosphere(camera, dir, t_start, t_end, hits_ground)) return;
+    if (!atmos_BeginRay(camera, dir, sky, ground, transmittance, hits_ground, t_start, t_end)) {
+        return;
+    }
     float r = length(camera);
     vec3 L = vec3(0.0), T = vec3(1.0);
     if (r <= ATMOS_TOP_RADIUS) {
@@ -310,7 +306,7 @@ void atmos_Evaluate(vec3 camera, vec3 dir, vec3 sun, out vec3 sky, out vec3 grou
     }
     sky = L;
     transmittance = T;
-    if (hits_ground && max(ATMOS_GROUND_ALBEDO.r, max(ATMOS_GROUND_ALBEDO.g, ATMOS_GROUND_ALBEDO.b)) > 0.0) {
+    if (hits_ground && atmos_GroundReflects()) {
         ground = atmos_GroundReflection(camera + dir * t_end, sun) * T;
     }
 }
