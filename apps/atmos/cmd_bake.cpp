@@ -202,6 +202,13 @@ Command AddViewerCommand(CLI::App* root) {
         if (!common->load.empty() && specs.size() != 1) {
             Fail("--load reads one model's tables: give one model in --models");
         }
+        for (const std::string& spec : specs) {  // before any precomputation
+            const std::string name = ParseModelSpec(spec).name;
+            if (!FindAsset(ShaderAsset(name))) {
+                Fail("model ", name, " has no shaders (", ShaderAsset(name),
+                     "): the viewer shows bruneton, hillaire and atmosphere-plus");
+            }
+        }
         const fs::path dir(*output);
         CheckOutputDirectory(dir.string());  // before any precomputation
         fs::create_directories(dir);
@@ -210,10 +217,6 @@ Command AddViewerCommand(CLI::App* root) {
             CommonOptions one = *common;
             one.model = spec;
             const std::string name = ParseModelSpec(spec).name;
-            if (!FindAsset(ShaderAsset(name))) {
-                Fail("model ", name, " has no shaders (", ShaderAsset(name),
-                     "): the viewer shows bruneton, hillaire and atmosphere-plus");
-            }
             BakeInto(one, (dir / name).string());
             WriteViewerData(dir / name, name);
             list += (list.empty() ? "" : ", ") + JsString(name);
