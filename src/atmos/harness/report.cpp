@@ -100,6 +100,17 @@ double MeanSeconds(const CompareResult& r, int m, bool* cached) {
     return sum / static_cast<double>(std::max<size_t>(1, r.rows.size()));
 }
 
+// A model's Prepare() seconds when it precomputes (its capabilities say so;
+// the others' Prepare() does next to nothing), else 0.
+double PrecomputeSeconds(const CompareResult& r, size_t m) {
+    if (m >= r.prepare_seconds.size()) return 0.0;
+    try {
+        return GetModelInfo(r.model_names[m]).capabilities.precomputed ? r.prepare_seconds[m] : 0.0;
+    } catch (const Error&) {
+        return 0.0;
+    }
+}
+
 std::string Duration(double seconds) {
     if (seconds >= 1.0) return General(seconds, 3) + " s";
     return General(1000.0 * seconds, 3) + " ms";
@@ -144,7 +155,8 @@ void TimeChart(std::ostream& f, const CompareConfig& config, const CompareResult
         const int yy = top + static_cast<int>(m) * row_h + 3;
         const double w = std::max(1.0, x.Map(std::max(seconds[m], x.lo)) - x.px0);
         std::string text = Duration(seconds[m]);
-        if (r.prepare_seconds[m] > 0.0) text += " + prepare " + Duration(r.prepare_seconds[m]);
+        if (PrecomputeSeconds(r, m) > 0.0)
+            text += " + prepare " + Duration(PrecomputeSeconds(r, m));
         if (cached[m]) text += " (cached: the time of the original render)";
         f << "<text x=\"" << label_w - 8 << "\" y=\"" << yy + 14
           << "\" text-anchor=\"end\" fill=\"#ddd\" font-size=\"12\">" << HtmlEscape(r.models[m])
@@ -201,7 +213,7 @@ void SummaryTable(std::ostream& f, const CompareConfig& config, const CompareRes
           << (s.prepare_seconds > 0.0 ? Duration(s.prepare_seconds) : std::string("&ndash;"))
           << "</td><td>" << Bytes(s.table_bytes) << "</td><td>"
           << (s.lines >= 0 ? std::to_string(s.lines) : std::string("&ndash;")) << "</td><td>"
-          << (s.pareto ? "yes" : "") << "</td><td style=\"text-align:left\">"
+          << (s.pareto ? "yes" : "") << "</td><td style=\"text-align:left;white-space:normal\">"
           << HtmlEscape(s.validity) << "</td></tr>\n";
     }
     f << "</table>\n";
@@ -323,49 +335,47 @@ void ColourBars(std::ostream& f, const CompareConfig& config, float exposure) {
     const bool transmittance = config.quantity == Quantity::kTransmittance;
     // The error image's display: 1 - exp(-exposure e), sRGB; the bar spans
     // where that is visibly below white.
-    const SvgAxis range = MakeSvgAxis(0.0, 4.0 / static_cast<double>(std::max(exposure, 1e-12f)), false, 0, 1);
+    const SvgAxis range =
+        MakeSvgAxis(0.0, 4.0 / static_cast<double>(std::max(exposure, 1e-12f)), false, 0, 1);
     f << "<svg class=\"plot colourbar\" data-plot=\"colour-bars\" "
-         "xmlns=\"http://www.w3.org/2000/svg\" width=\"820\" height=\"52\" role=\"img\" "
+         "xmlns=\"http://www.w3.org/2000/svg\" width=\"900\" height=\"52\" role=\"img\" "
          "aria-label=\"colour bars\">\n";
     SvgColourBar(
         f, 10, 16, 360, 0.0, 1.0,
         [](double v, unsigned char rgb[3]) { FlipMagma(static_cast<float>(v), rgb); },
         {0.0, 0.25, 0.5, 0.75, 1.0},
         std::string("FLIP map: ") + (transmittance ? "LDR" : "HDR") +
-            "-FLIP per pixel (unitless; 0: no visible difference, 1: the largest)");
+            "-FLIP per pixel (unitless, 0 to 1)");
     SvgColourBar(
-        f, 420, 16, 380, range.lo, range.hi,
+        f, 440, 16, 400, range.lo, range.hi,
         [exposure](double v, unsigned char rgb[3]) {
             rgb[0] = rgb[1] = rgb[2] = EncodeDisplayValue(static_cast<float>(v), exposure);
         },
         range.Ticks(),
         transmittance ? "error image: |model - reference| per channel (transmittance, unitless)"
-                      : "error image: |model - reference| per channel (linear radiance, image "
-                        "units; exposure " +
-                            General(exposure, 3) + ")");
+                      : "error image: |model - reference| per channel (linear radiance units)");
     f << "</svg>\n";
 }
 
 // Luminance along one line: the reference with its +-2 sigma band, every model.
 void ProfilePlot(std::ostream& f, const CompareRow& row, const CompareRow::Profile& p,
                  const CompareResult& r) {
-    const double left = 70, right = 520, top = 12, bottom = 210;
-    double hi = 0.0;
-    for (double v : p.reference) hi = std::max(hi, v);
+    const double left = 62, right = 430, top = 26, bottom = 210;
+    // The scale follows the reference: from its smallest positive value (at
+    // least 1/1000 of its largest) to the largest value of any line, at most
+    // 30 times the reference's largest; lines beyond run along the top edge.
+    double ref_hi = 0.0, all_hi = 0.0;
+    for (double v : p.reference) ref_hi = std::max(ref_hi, v);
     for (const auto& m : p.models) {
-        for (double v : m) hi = std::max(hi, v);
+        for (double v : m) all_hi = std::max(all_hi, v);
     }
-    if (!(hi > 0.0)) hi = 1.0;
-    double lo = hi;
+    if (!(ref_hi > 0.0)) ref_hi = all_hi > 0.0 ? all_hi : 1.0;
+    const double hi = std::clamp(all_hi, ref_hi, 30.0 * ref_hi);
+    double lo = ref_hi;
     for (double v : p.reference) {
         if (v > 0.0) lo = std::min(lo, v);
     }
-    for (const auto& m : p.models) {
-        for (double v : m) {
-            if (v > 0.0) lo = std::min(lo, v);
-        }
-    }
-    lo = std::max(lo, hi * 1e-4);  // the floor of the log axis
+    lo = std::max(lo, ref_hi * 1e-3);  // the floor of the log axis
     const std::vector<double>& a = p.line.angle_deg;
     if (a.empty()) return;
     SvgAxis xa = MakeSvgAxis(0.0, 1.0, false, left, right);
@@ -373,12 +383,14 @@ void ProfilePlot(std::ostream& f, const CompareRow& row, const CompareRow::Profi
     xa.hi = std::max(a.front(), a.back());
     const SvgAxis y = MakeSvgAxis(lo, hi, true, bottom, top);
     f << "<svg class=\"plot\" data-plot=\"profile\" xmlns=\"http://www.w3.org/2000/svg\" "
-         "width=\"700\" height=\""
-      << bottom + 48 << "\" role=\"img\" aria-label=\"profile " << HtmlEscape(row.label) << "\">\n"
-      << "<title>" << HtmlEscape(row.label + ": luminance along " + p.line.title) << "</title>\n";
+         "width=\"610\" height=\""
+      << bottom + 40 << "\" role=\"img\" aria-label=\"profile " << HtmlEscape(row.label) << "\">\n"
+      << "<title>" << HtmlEscape(row.label + ": luminance along " + p.line.title) << "</title>\n"
+      << "<text x=\"" << left << "\" y=\"14\" fill=\"#ddd\" font-size=\"12\">"
+      << HtmlEscape(row.label + ": " + p.line.title) << "</text>\n";
     SvgAxes(f, xa, y,
-            p.line.vertical ? "angle above the image centre (deg), " + p.line.title
-                            : "angle right of the image centre (deg), " + p.line.title,
+            p.line.vertical ? "angle above the image centre (deg)"
+                            : "angle right of the image centre (deg)",
             "luminance (log)");
     auto point = [&](size_t i, double v) {
         return Fixed(xa.Map(a[i]), 1) + "," + Fixed(y.Map(std::max(v, y.lo)), 1);
@@ -436,13 +448,15 @@ void ProfilePlot(std::ostream& f, const CompareRow& row, const CompareRow::Profi
     }
     if (!p.reference.empty()) series(p.reference, "reference", "#fff", 2.0);
     // Legend.
-    f << "<text x=\"" << right + 16 << "\" y=\"" << top + 8
-      << "\" fill=\"#fff\" font-size=\"11\">&#8212; reference"
-      << (p.reference_sigma.empty() ? "" : " (band: +-2 sigma)") << "</text>\n";
+    f << "<text x=\"" << right + 10 << "\" y=\"" << top + 8
+      << "\" fill=\"#fff\" font-size=\"10\">&#8212; reference"
+      << (p.reference_sigma.empty() ? "" : " (band &#177;2&#963;)") << "</text>\n";
     for (size_t m = 0; m < p.models.size(); ++m) {
-        f << "<text x=\"" << right + 16 << "\" y=\"" << top + 22 + 13.0 * static_cast<double>(m)
-          << "\" fill=\"" << SeriesColour(m) << "\" font-size=\"11\">&#8212; "
-          << HtmlEscape(r.models[m]) << "</text>\n";
+        double peak = 0.0;
+        for (double v : p.models[m]) peak = std::max(peak, v);
+        f << "<text x=\"" << right + 10 << "\" y=\"" << top + 21 + 13.0 * static_cast<double>(m)
+          << "\" fill=\"" << SeriesColour(m) << "\" font-size=\"10\">&#8212; "
+          << HtmlEscape(r.models[m]) << (peak > y.hi ? " (off the scale)" : "") << "</text>\n";
     }
     f << "</svg>\n";
 }
@@ -462,10 +476,12 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
       << "h1,h2{font-weight:normal}a{color:#8cf}\n"
       << "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #444;padding:"
          "3px 7px;font-size:13px}th{background:#222;font-weight:normal}\n"
-      << "td{text-align:right;font-family:monospace}caption{text-align:left;padding:4px 0}\n"
+      << "td{text-align:right;font-family:monospace;white-space:nowrap}caption{text-align:left;"
+         "padding:4px 0}\n"
       << "td.best{background:#274;color:#fff;font-weight:bold}\n"
       << "td.tie{background:#353;color:#eee}\n"
-      << "table.summary td{text-align:right}table.summary th{text-align:left}\n"
+      << "table.summary td{text-align:right;white-space:nowrap}table.summary th{text-align:left}"
+         "\n"
       << ".plots{display:flex;flex-wrap:wrap;gap:6px}\n"
       << "td.noise{font-style:italic;color:#888}\ntd.best.noise{color:#cdc}\n"
       << ".row{display:flex;gap:10px;overflow-x:auto;padding-bottom:8px}\n"
@@ -484,8 +500,25 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
          "(function () { var original = console.error; console.error = function () {\n"
          "  window.atmosErrors.push(Array.prototype.join.call(arguments, ' '));\n"
          "  return original.apply(console, arguments); }; })();\n</script>\n"
-      << "</head><body>\n<h1>" << HtmlEscape(title) << "</h1>\n";
+      << "</head><body>\n<h1>" << HtmlEscape(title) << "</h1>\n<p id=\"image-check\"></p>\n";
 
+    // Which model? The summary and accuracy against cost.
+    const std::vector<CompareSummary> summary = SummarizeCompare(config, r);
+    const double mean_noise = MeanReferenceNoise(r);
+    f << "<h2>Which model?</h2>\n<p>Accuracy against cost: each model's mean FLIP over the "
+         "views (the whisker reaches its worst view) against its render time per frame; a "
+         "hollow diamond on the dashed line marks its precomputation time, once per "
+         "atmosphere. The green staircase is the Pareto front: no other model is both faster "
+         "and more accurate. Hover a mark for its values. Ranks: models whose mean FLIP lies "
+         "within ";
+    if (mean_noise > 0.0) {
+        f << "the mean reference noise (" << General(mean_noise, 3) << ")";
+    } else {
+        f << "0 (the reference's noise is not measured: only equal values tie)";
+    }
+    f << " of a rank's first model share its rank (=).</p>\n";
+    AccuracyCostPlot(f, config, r, summary);
+    SummaryTable(f, config, r, summary);
     f << "<h2>Parameters and machine</h2>\n<dl>\n";
     auto item = [&](const std::string& k, const std::string& v) {
         f << "<dt>" << HtmlEscape(k) << "</dt><dd>" << HtmlEscape(v) << "</dd>\n";
@@ -534,25 +567,7 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
     item("compiler", CompilerName() + ", " + BuildType());
     item("date", UtcNow());
     item("total time", Fixed(r.total_seconds, 1) + " s");
-    f << "</dl>\n<p id=\"image-check\"></p>\n";
-
-    // Which model? The summary and accuracy against cost.
-    const std::vector<CompareSummary> summary = SummarizeCompare(config, r);
-    const double mean_noise = MeanReferenceNoise(r);
-    f << "<h2>Which model?</h2>\n<p>Accuracy against cost: each model's mean FLIP over the "
-         "views (the whisker reaches its worst view) against its render time per frame; a "
-         "hollow diamond on the dashed line marks its precomputation time, once per "
-         "atmosphere. The green staircase is the Pareto front: no other model is both faster "
-         "and more accurate. Hover a mark for its values. Ranks: models whose mean FLIP lies "
-         "within ";
-    if (mean_noise > 0.0) {
-        f << "the mean reference noise (" << General(mean_noise, 3) << ")";
-    } else {
-        f << "0 (the reference's noise is not measured: only equal values tie)";
-    }
-    f << " of a rank's first model share its rank (=).</p>\n";
-    AccuracyCostPlot(f, config, r, summary);
-    SummaryTable(f, config, r, summary);
+    f << "</dl>\n";
 
     f << "<h2>Errors against the reference</h2>\n<p>Best per row highlighted (green, bold) only "
          "when its lead over the next model exceeds the reference's noise in that row (FLIP: "
@@ -608,8 +623,8 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
     }
     f << ") against every model, log scale.</p>\n";
     for (const CompareRow& row : r.rows) {
-        f << "<h3>" << HtmlEscape(row.label) << "</h3><p>" << HtmlEscape(row.description)
-          << "</p>\n";
+        f << "<h3 id=\"view-" << HtmlEscape(row.view) << "\">" << HtmlEscape(row.label)
+          << "</h3><p>" << HtmlEscape(row.description) << "</p>\n";
         const float exposure = transmittance ? 1.0f : GetView(row.view, config.atmosphere).exposure;
         ColourBars(f, config, exposure);
         f << "<div class=\"row\">\n<figure><img src=\"" << HtmlEscape(row.reference_png)
@@ -696,7 +711,7 @@ std::vector<CompareSummary> SummarizeCompare(const CompareConfig& config, const 
         bool cached = false;
         s.frame_seconds = MeanSeconds(r, static_cast<int>(m), &cached);
         s.frame_seconds_1080p = s.frame_seconds * scale;
-        s.prepare_seconds = m < r.prepare_seconds.size() ? r.prepare_seconds[m] : 0.0;
+        s.prepare_seconds = PrecomputeSeconds(r, m);
         s.table_bytes = m < r.table_bytes.size() ? r.table_bytes[m] : -1;
         for (const ModelLoc& l : r.loc) {
             if (l.model == r.model_names[m]) {
