@@ -154,6 +154,50 @@ TEST(RenderCache, RoundTripAndKeying) {
     EXPECT_FALSE(cache.Load(key, &loaded, &seconds));
 }
 
+// Issue 22: a Monte Carlo render's variance travels with its image, and a
+// model's precomputation record (seconds, table bytes) is kept per model.
+TEST(RenderCache, KeepsTheVarianceAndThePrepareRecord) {
+    const fs::path dir = TempDir("cache_prepare");
+    const RenderCache cache(dir.string());
+    RenderKey key;
+    key.model = "reference";
+    key.options = ResolvedModelOptions("reference", {});
+    key.atmosphere_json = AtmosphereToJson(LoadAtmosphere("earth", {}));
+    key.view = "space";
+    key.width = 3;
+    key.height = 2;
+    key.monte_carlo = true;
+    Image img(3, 2), variance(3, 2);
+    variance.Set(1, 1, Rgb(0.25f, 0.5f, 0.75f));
+    MonteCarloReport report;
+    report.samples = 8;
+    report.noise = 0.02;
+    cache.Store(key, img, 2.0, &report, &variance);
+    Image loaded, loaded_variance;
+    double seconds = 0.0;
+    ASSERT_TRUE(cache.Load(key, &loaded, &seconds, nullptr, &loaded_variance));
+    ASSERT_EQ(loaded_variance.width(), 3);
+    EXPECT_EQ(loaded_variance.Get(1, 1).y, 0.5f);
+    // Stored without one: none comes back.
+    RenderKey plain = key;
+    plain.view = "ground-noon";
+    cache.Store(plain, img, 2.0, &report);
+    ASSERT_TRUE(cache.Load(plain, &loaded, &seconds, nullptr, &loaded_variance));
+    EXPECT_EQ(loaded_variance.size(), 0u);
+
+    double prepare = 0.0;
+    int64_t bytes = 0;
+    EXPECT_FALSE(cache.LoadPrepare(key, &prepare, &bytes));
+    cache.StorePrepare(key, 12.5, 4096);
+    ASSERT_TRUE(cache.LoadPrepare(plain, &prepare, &bytes));  // the view does not matter
+    EXPECT_EQ(prepare, 12.5);
+    EXPECT_EQ(bytes, 4096);
+    RenderKey other = key;
+    other.options["max-order"] = "2";
+    EXPECT_FALSE(cache.LoadPrepare(other, &prepare, &bytes));
+    fs::remove_all(dir);
+}
+
 TEST(Compare, ValidityFlags) {
     const AtmosphereParameters atm = LoadAtmosphere("earth", {});
     ModelCapabilities ground_only;

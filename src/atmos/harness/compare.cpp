@@ -11,6 +11,7 @@
 
 #include "atmos/error.h"
 #include "base/parallel.h"
+#include "harness/ranking.h"
 #include "harness/render_cache.h"
 #include "harness/report.h"
 #include "metrics/rmse.h"
@@ -23,6 +24,26 @@ namespace {
 
 double SecondsSince(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// The bytes of a prepared model's tables as float32: the size of the
+// tables.f32 its bake writes (io/raw_tables.h), baked into a scratch folder
+// under `output_dir`; -1 for a model without bakeable tables.
+int64_t TableBytes(const Model& model, const std::string& output_dir) {
+    if (!model.CanBake()) return -1;
+    const fs::path dir = fs::path(output_dir) / ".table-bytes";
+    int64_t bytes = -1;
+    try {
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+        model.Bake(dir.string());
+        bytes = static_cast<int64_t>(fs::file_size(dir / "tables.f32"));
+    } catch (const std::exception&) {
+        bytes = -1;
+    }
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+    return bytes;
 }
 
 // A model's images, rendered on demand: Prepare() runs once, only if some
@@ -47,14 +68,16 @@ class LazyRenderer {
         key_.quantity = config.quantity;
     }
 
+    // `variance` (optional, Monte Carlo models): the per-pixel variance of
+    // the estimate, empty when a cached image has none.
     Image Render(const View& view, double* seconds, bool* cached,
-                 MonteCarloReport* report = nullptr) {
+                 MonteCarloReport* report = nullptr, Image* variance = nullptr) {
         RenderKey key = key_;
         key.view = view.name;
         Image image;
         MonteCarloReport local;
         if (!report) report = &local;
-        if (cache_.Load(key, &image, seconds, report)) {
+        if (cache_.Load(key, &image, seconds, report, variance)) {
             *cached = true;
             return image;
         }
@@ -64,6 +87,8 @@ class LazyRenderer {
             model_->Prepare(config_.atmosphere);
             prepare_seconds_ = SecondsSince(start);
             prepared_ = true;
+            table_bytes_ = TableBytes(*model_, config_.output_dir);
+            cache_.StorePrepare(key_, prepare_seconds_, table_bytes_);
         }
         RenderRequest request;
         request.view = view;
@@ -73,16 +98,29 @@ class LazyRenderer {
         request.show_progress = config_.show_progress;
         request.monte_carlo = monte_carlo_;
         request.report = report;
+        if (key.monte_carlo) request.variance = variance;
         const auto start = std::chrono::steady_clock::now();
         model_->Render(request, &image);
         *seconds = SecondsSince(start);
         *cached = false;
-        cache_.Store(key, image, *seconds, key.monte_carlo ? report : nullptr);
+        cache_.Store(key, image, *seconds, key.monte_carlo ? report : nullptr,
+                     key.monte_carlo ? variance : nullptr);
         return image;
     }
 
     double prepare_seconds() const { return prepare_seconds_; }
     bool prepared() const { return prepared_; }
+    int64_t table_bytes() const { return table_bytes_; }
+    // Not prepared in this run: the cache's record of the last Prepare().
+    void LoadPrepareRecord() {
+        if (prepared_) return;
+        double seconds = 0.0;
+        int64_t bytes = -1;
+        if (cache_.LoadPrepare(key_, &seconds, &bytes)) {
+            prepare_seconds_ = seconds;
+            table_bytes_ = bytes;
+        }
+    }
 
   private:
     std::string name_;
@@ -94,6 +132,7 @@ class LazyRenderer {
     std::unique_ptr<Model> model_;
     double prepare_seconds_ = 0.0;
     bool prepared_ = false;
+    int64_t table_bytes_ = -1;
 };
 
 std::string FileStem(const std::string& name) {
@@ -163,7 +202,8 @@ int BestIndex(const std::vector<double>& row) {
 void WriteMetricCsv(const std::string& path, const std::string& corner,
                     const std::vector<std::string>& row_labels,
                     const std::vector<std::string>& columns,
-                    const std::vector<std::vector<double>>& values) {
+                    const std::vector<std::vector<double>>& values,
+                    const std::vector<double>& row_noise) {
     std::ofstream f(path);
     if (!f) Fail("cannot write '", path, "'");
     f << corner;
@@ -176,8 +216,12 @@ void WriteMetricCsv(const std::string& path, const std::string& corner,
             std::snprintf(buf, sizeof buf, "%.8g", v);
             f << "," << (std::isfinite(v) ? buf : "");
         }
-        const int best = BestIndex(values[r]);
-        f << "," << (best >= 0 ? columns[static_cast<size_t>(best)] : "") << "\n";
+        const double noise = r < row_noise.size() ? row_noise[r] : -1.0;
+        std::string best;
+        for (int m : BestOfRow(values[r], noise)) {
+            best += (best.empty() ? "" : " ") + columns[static_cast<size_t>(m)];
+        }
+        f << "," << best << "\n";
     }
     if (!f) Fail("cannot write '", path, "'");
 }
@@ -270,22 +314,56 @@ CompareResult RunCompare(const CompareConfig& config) {
         fs::create_directories(image_dir);
         fs::create_directories(error_dir);
         MonteCarloReport ref_report;
-        Image ref =
-            reference.Render(view, &row.reference_seconds, &row.reference_cached, &ref_report);
+        Image ref_variance;  // per-pixel variance of the reference's estimate (may stay empty)
+        Image ref = reference.Render(view, &row.reference_seconds, &row.reference_cached,
+                                     &ref_report, &ref_variance);
         row.reference_spp = ref_report.samples;
         if (noise_target) row.reference_noise = ref_report.noise;
         if (split_reference) {
             double seconds_b = 0.0;
             bool cached_b = false;
-            const Image b = reference_b.Render(view, &seconds_b, &cached_b);
+            Image variance_b;
+            const Image b = reference_b.Render(view, &seconds_b, &cached_b, nullptr, &variance_b);
             row.reference_noise = HdrFlip(ref, b, config.flip).mean;
             const float wa = static_cast<float>(spp_a) / static_cast<float>(spp_a + spp_b);
+            // The variance of the weighted mean: from the halves' own estimates,
+            // else from their difference (E[(a - b)^2] = var_a + var_b).
+            if (ref_variance.size() == ref.size() && variance_b.size() == b.size()) {
+                for (size_t i = 0; i < ref.size(); ++i) {
+                    ref_variance.data()[i] = wa * wa * ref_variance.data()[i] +
+                                             (1.0f - wa) * (1.0f - wa) * variance_b.data()[i];
+                }
+            } else {
+                ref_variance.Resize(ref.width(), ref.height());
+                for (size_t i = 0; i < ref.size(); ++i) {
+                    const float d = ref.data()[i] - b.data()[i];
+                    ref_variance.data()[i] = d * d * 0.25f;
+                }
+            }
             for (size_t i = 0; i < ref.size(); ++i) {
                 ref.data()[i] = wa * ref.data()[i] + (1.0f - wa) * b.data()[i];
             }
             row.reference_seconds += seconds_b;
             row.reference_spp = spp_a + spp_b;
             row.reference_cached = row.reference_cached && cached_b;
+        }
+        if (ref_variance.size() == ref.size() && ref.size() > 0) {
+            double sum = 0.0;
+            for (size_t i = 0; i < ref_variance.size(); ++i) sum += static_cast<double>(ref_variance.data()[i]);
+            row.reference_rmse_noise = 2.0 * std::sqrt(sum / static_cast<double>(ref.size()));
+        } else {
+            ref_variance = Image();
+        }
+        if (!transmittance) {
+            for (const ProfileLine& line : ViewProfileLines(view, config.width, config.height,
+                                                            config.atmosphere.bottom_radius)) {
+                CompareRow::Profile profile;
+                profile.line = line;
+                profile.reference = ProfileLuminance(ref, line);
+                if (ref_variance.size() > 0)
+                    profile.reference_sigma = ProfileSigma(ref_variance, line);
+                row.profiles.push_back(std::move(profile));
+            }
         }
         WriteImages(ref, image_dir, "reference", exposure, config.write_npy);
         row.reference_png = (fs::path("images") / FileStem(view.name) / "reference.png").string();
@@ -313,6 +391,9 @@ CompareResult RunCompare(const CompareConfig& config) {
             const RmseResult rmse = ComputeRmse(ref, img);
             cell.flip = flip.mean;
             cell.rmse = rmse.overall;
+            for (CompareRow::Profile& profile : row.profiles) {
+                profile.models.push_back(ProfileLuminance(img, profile.line));
+            }
             cell.within_noise = row.reference_noise >= 0.0 && cell.flip <= row.reference_noise;
             WriteColorMappedPng(flip.map, flip.width, flip.height,
                                 (error_dir / (stem + "-flip.png")).string());
@@ -337,8 +418,10 @@ CompareResult RunCompare(const CompareConfig& config) {
         result.rows.push_back(row);
     }
     for (const auto& r : renderers) {
+        r->LoadPrepareRecord();
         result.prepare_seconds.push_back(r->prepare_seconds());
         result.prepared.push_back(r->prepared());
+        result.table_bytes.push_back(r->table_bytes());
     }
     result.reference_prepare_seconds = reference.prepare_seconds() + reference_b.prepare_seconds();
     const std::string source_dir = DefaultSourceDir();
@@ -355,8 +438,11 @@ CompareResult RunCompare(const CompareConfig& config) {
     // Tables (thesis Appendix A/B, or C/D for transmittance) and times.
     std::vector<std::string> labels;
     std::vector<std::vector<double>> flips, rmses;
+    std::vector<double> flip_noise, rmse_noise;
     for (const CompareRow& row : result.rows) {
         labels.push_back(row.label);
+        flip_noise.push_back(row.reference_noise);
+        rmse_noise.push_back(row.reference_rmse_noise);
         std::vector<double> f, r;
         for (const CompareCell& c : row.cells) {
             f.push_back(c.flip);
@@ -365,8 +451,10 @@ CompareResult RunCompare(const CompareConfig& config) {
         flips.push_back(f);
         rmses.push_back(r);
     }
-    WriteMetricCsv((out / "flip.csv").string(), "FLIP errors", labels, result.models, flips);
-    WriteMetricCsv((out / "rmse.csv").string(), "RMSE errors", labels, result.models, rmses);
+    WriteMetricCsv((out / "flip.csv").string(), "FLIP errors", labels, result.models, flips,
+                   flip_noise);
+    WriteMetricCsv((out / "rmse.csv").string(), "RMSE errors", labels, result.models, rmses,
+                   rmse_noise);
     if (split_reference || noise_target) {
         std::ofstream f(out / "reference_noise.csv");
         f << "view,reference_noise_flip,half_spp,noise_target\n";
@@ -390,6 +478,7 @@ CompareResult RunCompare(const CompareConfig& config) {
         }
     }
     result.total_seconds = SecondsSince(start);
+    WriteAccuracyCostCsv((out / "accuracy_cost.csv").string(), config, result);
     WriteCompareReport((out / "index.html").string(), config, result);
     return result;
 }

@@ -18,6 +18,7 @@
 #include "atmos/model.h"
 #include "atmos/view.h"
 #include "harness/loc.h"
+#include "harness/profiles.h"
 #include "metrics/flip.h"
 
 namespace atmos {
@@ -73,8 +74,22 @@ struct CompareRow {
     // halves: the reference's own noise, an upper bound for its error at the full
     // spp. Negative when not measured (deterministic reference, transmittance).
     double reference_noise = -1.0;
-    int64_t reference_spp = 0;       // paths per pixel of the (whole) reference
+    int64_t reference_spp = 0;  // paths per pixel of the (whole) reference
+    // Twice the reference's RMS standard error (sqrt of the mean per-pixel
+    // variance of its estimate): its noise in RMSE units, the tie tolerance of
+    // the RMSE table. Negative when not known.
+    double reference_rmse_noise = -1.0;
     std::vector<CompareCell> cells;  // one per model, in CompareResult::models order
+    // Luminance along the column through the sun and the row above the
+    // horizon (profiles.h): the reference, its standard deviation (empty when
+    // not known) and each model (CompareResult::models order).
+    struct Profile {
+        ProfileLine line;
+        std::vector<double> reference;
+        std::vector<double> reference_sigma;
+        std::vector<std::vector<double>> models;
+    };
+    std::vector<Profile> profiles;
 };
 
 struct CompareResult {
@@ -83,6 +98,10 @@ struct CompareResult {
     std::vector<std::string> model_titles;
     std::vector<double> prepare_seconds;  // per model; 0 when every image came from the cache
     std::vector<bool> prepared;
+    // Bytes of each model's precomputed tables as float32 (the size of the
+    // tables.f32 of `atmos bake`); -1 when the model has no bakeable tables or
+    // was not prepared in this run or a cached one.
+    std::vector<int64_t> table_bytes;
     double reference_prepare_seconds = 0.0;
     std::vector<CompareRow> rows;
     std::vector<ModelLoc> loc;  // per registered model (once), plus the reference model last
@@ -109,11 +128,14 @@ CompareResult RunCompare(const CompareConfig& config);
 
 // A metric table as CSV (thesis Appendix A/B layout): the header
 // "<corner>,<model>...,best", then one row per view with the values (%.8g)
-// and the name of the model with the lowest value.
+// and the name of the model with the lowest value; with a noise per row
+// (ranking.h: BestOfRow), every model within that row's noise of the lowest,
+// separated by spaces (a tie).
 void WriteMetricCsv(const std::string& path, const std::string& corner,
                     const std::vector<std::string>& row_labels,
                     const std::vector<std::string>& columns,
-                    const std::vector<std::vector<double>>& values);
+                    const std::vector<std::vector<double>>& values,
+                    const std::vector<double>& row_noise = {});
 // Index of the lowest finite value of a row (-1 if none).
 int BestIndex(const std::vector<double>& row);
 

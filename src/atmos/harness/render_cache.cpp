@@ -79,7 +79,7 @@ std::string RenderCache::ImagePath(const RenderKey& key) const {
 }
 
 bool RenderCache::Load(const RenderKey& key, Image* image, double* render_seconds,
-                       MonteCarloReport* report) const {
+                       MonteCarloReport* report, Image* variance) const {
     if (!enabled()) return false;
     const std::string exr = ImagePath(key);
     const std::string meta = exr.substr(0, exr.size() - 4) + ".json";
@@ -97,6 +97,14 @@ bool RenderCache::Load(const RenderKey& key, Image* image, double* render_second
             report->samples = j.value("samples", static_cast<int64_t>(0));
             report->noise = j.value("noise", -1.0);
         }
+        if (variance) {
+            *variance = Image();
+            const std::string file = exr.substr(0, exr.size() - 4) + ".variance.exr";
+            if (j.value("variance", false) && fs::exists(file, ec)) {
+                Image v = ReadImage(file);
+                if (v.width() == key.width && v.height() == key.height) *variance = std::move(v);
+            }
+        }
         return true;
     } catch (const std::exception&) {
         return false;  // a damaged entry is re-rendered (and overwritten)
@@ -104,7 +112,7 @@ bool RenderCache::Load(const RenderKey& key, Image* image, double* render_second
 }
 
 void RenderCache::Store(const RenderKey& key, const Image& image, double render_seconds,
-                        const MonteCarloReport* report) const {
+                        const MonteCarloReport* report, const Image* variance) const {
     if (!enabled()) return;
     fs::create_directories(directory_);
     const std::string exr = ImagePath(key);
@@ -117,9 +125,58 @@ void RenderCache::Store(const RenderKey& key, const Image& image, double render_
         j["samples"] = report->samples;
         j["noise"] = report->noise;
     }
+    if (variance && variance->width() == image.width() && variance->height() == image.height()) {
+        WriteImage(*variance, exr.substr(0, exr.size() - 4) + ".variance.exr");
+        j["variance"] = true;
+    }
     std::ofstream f(meta);
     f << j.dump(1) << "\n";
     if (!f) Fail("cannot write '", meta, "'");
+}
+
+namespace {
+
+std::string PreparePath(const std::string& directory, const RenderKey& key) {
+    RenderKey k = key;
+    k.view = "(prepare)";
+    char hash[17];
+    std::snprintf(hash, sizeof hash, "%016llx",
+                  static_cast<unsigned long long>(Fnv1a64(RenderKeyText(k))));
+    return (fs::path(directory) / (key.model + "-prepare-" + hash + ".json")).string();
+}
+
+}  // namespace
+
+bool RenderCache::LoadPrepare(const RenderKey& key, double* seconds, int64_t* table_bytes) const {
+    if (!enabled()) return false;
+    RenderKey k = key;
+    k.view = "(prepare)";
+    try {
+        std::ifstream f(PreparePath(directory_, key));
+        if (!f) return false;
+        const nlohmann::json j = nlohmann::json::parse(f);
+        if (j.at("key").get<std::string>() != RenderKeyText(k)) return false;
+        *seconds = j.at("prepare_seconds").get<double>();
+        *table_bytes = j.at("table_bytes").get<int64_t>();
+        return true;
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
+void RenderCache::StorePrepare(const RenderKey& key, double seconds, int64_t table_bytes) const {
+    if (!enabled()) return;
+    fs::create_directories(directory_);
+    RenderKey k = key;
+    k.view = "(prepare)";
+    nlohmann::json j;
+    j["key"] = RenderKeyText(k);
+    j["prepare_seconds"] = seconds;
+    j["table_bytes"] = table_bytes;
+    const std::string path = PreparePath(directory_, key);
+    std::ofstream f(path);
+    f << j.dump(1) << "\n";
+    if (!f) Fail("cannot write '", path, "'");
 }
 
 }  // namespace atmos

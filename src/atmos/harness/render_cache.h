@@ -48,10 +48,17 @@ class RenderCache {
     bool enabled() const { return !directory_.empty(); }
     // Loads the image and the seconds its render took; false when absent or stale.
     // A Monte Carlo render's report (reached noise, paths) travels with it.
+    // A Monte Carlo render's per-pixel variance, when stored with it, is
+    // loaded into `variance` (left empty when absent).
     bool Load(const RenderKey& key, Image* image, double* render_seconds,
-              MonteCarloReport* report = nullptr) const;
+              MonteCarloReport* report = nullptr, Image* variance = nullptr) const;
     void Store(const RenderKey& key, const Image& image, double render_seconds,
-               const MonteCarloReport* report = nullptr) const;
+               const MonteCarloReport* report = nullptr, const Image* variance = nullptr) const;
+    // A model's precomputation (Prepare() seconds, bytes of its tables or -1),
+    // keyed by the key's model, options, atmosphere and build (view and size
+    // as given), so a run whose images all come from the cache still reports it.
+    bool LoadPrepare(const RenderKey& key, double* seconds, int64_t* table_bytes) const;
+    void StorePrepare(const RenderKey& key, double seconds, int64_t table_bytes) const;
     // The EXR file of a key (whether or not it exists).
     std::string ImagePath(const RenderKey& key) const;
 

@@ -1,0 +1,134 @@
+// atmos: radiance profiles of `atmos compare` (see profiles.h).
+#include "harness/profiles.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace atmos {
+
+namespace {
+
+constexpr double kWeights[3] = {0.2126, 0.7152, 0.0722};
+constexpr double kDeg = 180.0 / 3.14159265358979323846;
+
+std::string Degrees(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.1f", v);
+    return buf;
+}
+
+const float* Pixel(const Image& image, const ProfileLine& line, int i) {
+    const int x = line.vertical ? line.index : i;
+    const int y = line.vertical ? i : line.index;
+    return image.data() + 3 * (static_cast<size_t>(y) * image.width() + x);
+}
+
+int Samples(const Image& image, const ProfileLine& line) {
+    return line.vertical ? image.height() : image.width();
+}
+
+}  // namespace
+
+std::vector<ProfileLine> ViewProfileLines(const View& view, int width, int height,
+                                          double bottom_radius) {
+    const Camera& c = view.camera;
+    const double aspect = static_cast<double>(width) / height;
+    const double tan_x = c.tan_half_fov_y * aspect;
+
+    // The sun's column.
+    const Vec3d& d = view.sun_direction;
+    const double dz = Dot(d, c.forward);
+    double sun_x = 0.5 * width;
+    bool in_frame = false;
+    if (dz > 0.0) {
+        const double u = Dot(d, c.right) / dz / tan_x;
+        sun_x = 0.5 * (u + 1.0) * width;
+        const double v = Dot(d, c.up) / dz / c.tan_half_fov_y;
+        in_frame = std::fabs(u) <= 1.0 && std::fabs(v) <= 1.0;
+    } else {
+        sun_x = Dot(d, c.right) >= 0.0 ? width : 0.0;
+    }
+    const int column = std::clamp(static_cast<int>(std::floor(sun_x)), 0, width - 1);
+
+    // The row just above the horizon in that column: the ray is above the
+    // tangent to the ground sphere (elevation > -acos(R / r)).
+    const double r = Length(c.position);
+    const Vec3d up = c.position / r;
+    const double horizon_sin =
+        r > bottom_radius ? -std::sqrt(1.0 - std::pow(bottom_radius / r, 2)) : 0.0;
+    int row = -1;
+    for (int y = height - 1; y >= 0 && row < 0; --y) {
+        if (Dot(c.RayDirection(column, y, width, height), up) > horizon_sin) row = y;
+    }
+    std::string row_why;
+    const bool horizon_in_frame = row >= 0 && row < height - 1;  // the row below it sees the ground
+    if (row < 0) {
+        row = 0;
+        row_why = "top row (the horizon is above the frame)";
+    } else if (row == height - 1) {
+        row_why = "bottom row (the horizon is below the frame)";
+    } else {
+        row_why = "row " + std::to_string(row) + ", just above the horizon";
+    }
+
+    ProfileLine vertical;
+    vertical.vertical = true;
+    vertical.index = column;
+    vertical.title =
+        "column " + std::to_string(column) +
+        (in_frame ? ", through the sun" : ", nearest to the sun (the sun is outside the frame)");
+    for (int y = 0; y < height; ++y) {
+        const double v = (1.0 - 2.0 * (y + 0.5) / height) * c.tan_half_fov_y;
+        vertical.angle_deg.push_back(std::atan(v) * kDeg);
+    }
+    if (horizon_in_frame) {
+        vertical.marker = row;
+        vertical.marker_label = "horizon";
+    }
+
+    ProfileLine horizontal;
+    horizontal.vertical = false;
+    horizontal.index = row;
+    horizontal.title = row_why;
+    for (int x = 0; x < width; ++x) {
+        const double u = (2.0 * (x + 0.5) / width - 1.0) * tan_x;
+        horizontal.angle_deg.push_back(std::atan(u) * kDeg);
+    }
+    if (dz > 0.0 && sun_x >= 0.0 && sun_x < width) {
+        horizontal.marker = column;
+        horizontal.marker_label = "sun's column";
+    }
+    if (horizon_in_frame) {
+        horizontal.title +=
+            " (" +
+            Degrees(std::asin(std::clamp(Dot(c.RayDirection(column, row, width, height), up), -1.0,
+                                         1.0)) *
+                    kDeg) +
+            " deg elevation in the sun's column)";
+    }
+    return {vertical, horizontal};
+}
+
+std::vector<double> ProfileLuminance(const Image& image, const ProfileLine& line) {
+    std::vector<double> out;
+    for (int i = 0; i < Samples(image, line); ++i) {
+        const float* p = Pixel(image, line, i);
+        out.push_back(kWeights[0] * static_cast<double>(p[0]) + kWeights[1] * static_cast<double>(p[1]) +
+                      kWeights[2] * static_cast<double>(p[2]));
+    }
+    return out;
+}
+
+std::vector<double> ProfileSigma(const Image& variance, const ProfileLine& line) {
+    std::vector<double> out;
+    for (int i = 0; i < Samples(variance, line); ++i) {
+        const float* p = Pixel(variance, line, i);
+        double s = 0.0;
+        for (int ch = 0; ch < 3; ++ch) s += kWeights[ch] * std::sqrt(std::max(0.0, static_cast<double>(p[ch])));
+        out.push_back(s);
+    }
+    return out;
+}
+
+}  // namespace atmos
