@@ -19,8 +19,11 @@
 #include <string>
 #include <vector>
 
+#include "atmos/atmosphere.h"
 #include "atmos/image.h"
+#include "atmos/view.h"
 #include "chromium_util.h"
+#include "harness/profiles.h"
 #include "harness/ranking.h"
 #include "harness/report.h"
 
@@ -236,6 +239,60 @@ TEST(Report, MarksTheBestOnlyWhenItsLeadExceedsTheReferenceNoise) {
     EXPECT_EQ(summary[1].unresolved_views, 1);
     EXPECT_NEAR(summary[1].frame_seconds_1080p, 0.01 * 1920 * 1080 / (32 * 18), 1e-9);
     fs::remove_all(dir);
+}
+
+}  // namespace
+
+namespace {
+
+// The profile lines' geometry: the column holds the pixel whose ray is
+// closest to the sun; the row is the last one above the ground sphere.
+TEST(Profiles, ColumnThroughTheSunAndRowAboveTheHorizon) {
+    const atmos::AtmosphereParameters atmosphere;
+    const atmos::View view = atmos::GetView("ground-sunrise", atmosphere);
+    const int w = 160, h = 90;
+    const std::vector<atmos::ProfileLine> lines =
+        atmos::ViewProfileLines(view, w, h, atmosphere.bottom_radius, atmosphere.top_radius);
+    ASSERT_EQ(lines.size(), 2u);
+    const atmos::ProfileLine& column = lines[0];
+    const atmos::ProfileLine& row = lines[1];
+    ASSERT_TRUE(column.vertical);
+    ASSERT_FALSE(row.vertical);
+    EXPECT_NE(column.title.find("through the sun"), std::string::npos) << column.title;
+    // The pixel whose ray is nearest the sun is in `column` (or ties with one there: here
+    // the sun is on the centre line between columns 79 and 80).
+    double best = -2.0, best_in_column = -2.0;
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            const double c = atmos::Dot(view.camera.RayDirection(x, y, w, h), view.sun_direction);
+            best = std::max(best, c);
+            if (x == column.index) best_in_column = std::max(best_in_column, c);
+        }
+    }
+    EXPECT_NEAR(best_in_column, best, 1e-12);
+    // The row sees above the horizon, the one below it the ground (camera on the ground:
+    // elevation 0 within a few metres of altitude).
+    const atmos::Vec3d up = view.camera.position / atmos::Length(view.camera.position);
+    const double r = atmos::Length(view.camera.position);
+    const double tangent = -std::sqrt(1.0 - std::pow(atmosphere.bottom_radius / r, 2));
+    ASSERT_GT(row.index, 0);
+    ASSERT_LT(row.index, h - 1);
+    EXPECT_GT(atmos::Dot(view.camera.RayDirection(column.index, row.index, w, h), up), tangent);
+    EXPECT_LE(atmos::Dot(view.camera.RayDirection(column.index, row.index + 1, w, h), up), tangent);
+    EXPECT_EQ(column.marker, row.index);
+    EXPECT_EQ(row.marker, column.index);
+    EXPECT_EQ(column.angle_deg.size(), static_cast<size_t>(h));
+    EXPECT_GT(column.angle_deg.front(), column.angle_deg.back());  // top row first
+    // Luminance of a constant image is its Rec. 709 weighted sum.
+    atmos::Image image(w, h);
+    for (size_t i = 0; i < image.size(); i += 3) {
+        image.data()[i] = 1.0f;
+        image.data()[i + 1] = 2.0f;
+        image.data()[i + 2] = 4.0f;
+    }
+    const std::vector<double> y = atmos::ProfileLuminance(image, row);
+    ASSERT_EQ(y.size(), static_cast<size_t>(w));
+    EXPECT_NEAR(y[7], 0.2126 + 2 * 0.7152 + 4 * 0.0722, 1e-12);
 }
 
 }  // namespace

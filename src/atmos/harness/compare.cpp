@@ -349,14 +349,16 @@ CompareResult RunCompare(const CompareConfig& config) {
         }
         if (ref_variance.size() == ref.size() && ref.size() > 0) {
             double sum = 0.0;
-            for (size_t i = 0; i < ref_variance.size(); ++i) sum += static_cast<double>(ref_variance.data()[i]);
+            for (size_t i = 0; i < ref_variance.size(); ++i)
+                sum += static_cast<double>(ref_variance.data()[i]);
             row.reference_rmse_noise = 2.0 * std::sqrt(sum / static_cast<double>(ref.size()));
         } else {
             ref_variance = Image();
         }
         if (!transmittance) {
-            for (const ProfileLine& line : ViewProfileLines(view, config.width, config.height,
-                                                            config.atmosphere.bottom_radius)) {
+            for (const ProfileLine& line :
+                 ViewProfileLines(view, config.width, config.height,
+                                  config.atmosphere.bottom_radius, config.atmosphere.top_radius)) {
                 CompareRow::Profile profile;
                 profile.line = line;
                 profile.reference = ProfileLuminance(ref, line);

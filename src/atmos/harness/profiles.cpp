@@ -31,53 +31,68 @@ int Samples(const Image& image, const ProfileLine& line) {
 }  // namespace
 
 std::vector<ProfileLine> ViewProfileLines(const View& view, int width, int height,
-                                          double bottom_radius) {
+                                          double bottom_radius, double top_radius) {
     const Camera& c = view.camera;
     const double aspect = static_cast<double>(width) / height;
     const double tan_x = c.tan_half_fov_y * aspect;
 
-    // The sun's column.
+    // The sun's column, when the sun is in front of the camera and within the
+    // frame's width; else the centre column.
     const Vec3d& d = view.sun_direction;
     const double dz = Dot(d, c.forward);
-    double sun_x = 0.5 * width;
-    bool in_frame = false;
+    double sun_x = -1.0;
+    bool above_or_below = false;
     if (dz > 0.0) {
         const double u = Dot(d, c.right) / dz / tan_x;
-        sun_x = 0.5 * (u + 1.0) * width;
         const double v = Dot(d, c.up) / dz / c.tan_half_fov_y;
-        in_frame = std::fabs(u) <= 1.0 && std::fabs(v) <= 1.0;
-    } else {
-        sun_x = Dot(d, c.right) >= 0.0 ? width : 0.0;
+        if (std::fabs(u) <= 1.0) sun_x = 0.5 * (u + 1.0) * width;
+        above_or_below = std::fabs(v) > 1.0;
     }
-    const int column = std::clamp(static_cast<int>(std::floor(sun_x)), 0, width - 1);
+    const bool sun_column = sun_x >= 0.0;
+    const int column =
+        sun_column ? std::clamp(static_cast<int>(std::floor(sun_x)), 0, width - 1) : width / 2;
 
-    // The row just above the horizon in that column: the ray is above the
-    // tangent to the ground sphere (elevation > -acos(R / r)).
+    // The row just above the horizon (or the planet's limb seen from space) in
+    // that column: the row above the first one, from the top, whose ray passes
+    // below the tangent to the ground sphere (elevation < -acos(R / r)).
     const double r = Length(c.position);
     const Vec3d up = c.position / r;
     const double horizon_sin =
         r > bottom_radius ? -std::sqrt(1.0 - std::pow(bottom_radius / r, 2)) : 0.0;
-    int row = -1;
-    for (int y = height - 1; y >= 0 && row < 0; --y) {
-        if (Dot(c.RayDirection(column, y, width, height), up) > horizon_sin) row = y;
+    int hit = height;  // the first row that sees the ground
+    for (int y = 0; y < height && hit == height; ++y) {
+        if (Dot(c.RayDirection(column, y, width, height), up) <= horizon_sin) hit = y;
     }
+    int row = hit - 1;
     std::string row_why;
-    const bool horizon_in_frame = row >= 0 && row < height - 1;  // the row below it sees the ground
-    if (row < 0) {
+    const bool horizon_in_frame = hit > 0 && hit < height;
+    if (hit == 0) {
         row = 0;
         row_why = "top row (the horizon is above the frame)";
-    } else if (row == height - 1) {
+    } else if (hit == height) {
         row_why = "bottom row (the horizon is below the frame)";
     } else {
         row_why = "row " + std::to_string(row) + ", just above the horizon";
+    }
+    // Far above the atmosphere its shell at the limb is thinner than 3 pixels
+    // and the row above the limb sees black space: the centre row (across the
+    // planet) instead.
+    const double pixel = 2.0 * std::atan(c.tan_half_fov_y) / height;
+    const bool outside =
+        r > top_radius && std::acos(bottom_radius / r) - std::acos(top_radius / r) < 3.0 * pixel;
+    if (outside) {
+        row = height / 2;
+        row_why = "row " + std::to_string(row) +
+                  ", the centre (the atmosphere at the limb is under 3 pixels thick)";
     }
 
     ProfileLine vertical;
     vertical.vertical = true;
     vertical.index = column;
-    vertical.title =
-        "column " + std::to_string(column) +
-        (in_frame ? ", through the sun" : ", nearest to the sun (the sun is outside the frame)");
+    vertical.title = "column " + std::to_string(column) +
+                     (!sun_column      ? ", the centre (the sun is outside the frame's width)"
+                      : above_or_below ? ", the sun's (the sun is above or below the frame)"
+                                       : ", through the sun");
     for (int y = 0; y < height; ++y) {
         const double v = (1.0 - 2.0 * (y + 0.5) / height) * c.tan_half_fov_y;
         vertical.angle_deg.push_back(std::atan(v) * kDeg);
@@ -95,17 +110,17 @@ std::vector<ProfileLine> ViewProfileLines(const View& view, int width, int heigh
         const double u = (2.0 * (x + 0.5) / width - 1.0) * tan_x;
         horizontal.angle_deg.push_back(std::atan(u) * kDeg);
     }
-    if (dz > 0.0 && sun_x >= 0.0 && sun_x < width) {
+    if (sun_column) {
         horizontal.marker = column;
         horizontal.marker_label = "sun's column";
     }
-    if (horizon_in_frame) {
+    if (horizon_in_frame && !outside) {
         horizontal.title +=
             " (" +
             Degrees(std::asin(std::clamp(Dot(c.RayDirection(column, row, width, height), up), -1.0,
                                          1.0)) *
                     kDeg) +
-            " deg elevation in the sun's column)";
+            " deg elevation in that column)";
     }
     return {vertical, horizontal};
 }
@@ -114,7 +129,8 @@ std::vector<double> ProfileLuminance(const Image& image, const ProfileLine& line
     std::vector<double> out;
     for (int i = 0; i < Samples(image, line); ++i) {
         const float* p = Pixel(image, line, i);
-        out.push_back(kWeights[0] * static_cast<double>(p[0]) + kWeights[1] * static_cast<double>(p[1]) +
+        out.push_back(kWeights[0] * static_cast<double>(p[0]) +
+                      kWeights[1] * static_cast<double>(p[1]) +
                       kWeights[2] * static_cast<double>(p[2]));
     }
     return out;
@@ -125,7 +141,8 @@ std::vector<double> ProfileSigma(const Image& variance, const ProfileLine& line)
     for (int i = 0; i < Samples(variance, line); ++i) {
         const float* p = Pixel(variance, line, i);
         double s = 0.0;
-        for (int ch = 0; ch < 3; ++ch) s += kWeights[ch] * std::sqrt(std::max(0.0, static_cast<double>(p[ch])));
+        for (int ch = 0; ch < 3; ++ch)
+            s += kWeights[ch] * std::sqrt(std::max(0.0, static_cast<double>(p[ch])));
         out.push_back(s);
     }
     return out;

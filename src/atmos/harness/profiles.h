@@ -27,12 +27,15 @@ struct ProfileLine {
 };
 
 // The two lines of a view of `width` x `height` pixels: the column through
-// the sun (the nearest column when the sun is outside the frame) and the row
-// just above the horizon (the lowest row of the sun's column whose ray passes
-// above the ground sphere of radius bottom_radius; the top or bottom row when
-// none or all do).
+// the sun (the centre column when the sun is behind the camera or outside the
+// frame's width) and the row just above the horizon in that column (the row
+// above the first one, from the top, whose ray meets the ground sphere of
+// radius bottom_radius; the top or bottom row when the horizon is outside the
+// frame). Where the atmosphere's shell at the limb is under 3 pixels thick
+// (a camera far above top_radius) the row above the limb sees black space: the
+// centre row instead, across the planet.
 std::vector<ProfileLine> ViewProfileLines(const View& view, int width, int height,
-                                          double bottom_radius);
+                                          double bottom_radius, double top_radius);
 
 // Linear luminance (Rec. 709: 0.2126 R + 0.7152 G + 0.0722 B) along the line.
 std::vector<double> ProfileLuminance(const Image& image, const ProfileLine& line);
