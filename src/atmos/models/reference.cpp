@@ -148,11 +148,13 @@ const OptionTable<ReferenceOptions>& ReferenceModel::OptionRows() {
                   "hybrid: factor on the majorants of continuation segments (more, cheaper "
                   "next-event estimates per path)")
             .Integer("nee-comb", &O::nee_comb, 0, kMaxNeeComb, "",
-                     "hybrid: stratified uniform next-event points per continuation segment, "
-                     "MIS-weighted with the collisions' estimates (0: none)")
+                     "hybrid: stratified uniform next-event points per continuation segment "
+                     "that starts with the sun below its horizon (twilight), MIS-weighted with "
+                     "the collisions' estimates (0: none)")
             .Real("sun-lobe", &O::sun_lobe, 0.0, 0.95, "",
                   "hybrid: probability of drawing the first continuation direction from a "
-                  "Henyey-Greenstein lobe around the sun (MIS with the phase function; 0: none)")
+                  "Henyey-Greenstein lobe around the sun at a first vertex with the sun below "
+                  "its horizon (twilight; MIS with the phase function; 0: none)")
             .Real("sun-lobe-g", &O::sun_lobe_g, 0.0, 0.99, "",
                   "hybrid: the sun lobe's Henyey-Greenstein g");
     return table;

@@ -1035,8 +1035,8 @@ struct ReferenceOptions {
     int max_order = 0;            // 0: unlimited
     int shells = 0;               // altitude shells of the majorant (0: 8 hybrid, 48 else)
     double majorant_scale = 4.0;  // hybrid: factor on the continuation majorants
-    int nee_comb = 0;             // hybrid: comb points per continuation segment
-    double sun_lobe = 0.0;        // hybrid: the first direction's sun-lobe probability
+    int nee_comb = 2;             // hybrid: comb points per continuation segment (twilight)
+    double sun_lobe = 0.5;        // hybrid: the first direction's sun-lobe probability (twilight)
     double sun_lobe_g = 0.8;      // hybrid: its Henyey-Greenstein g
 };
 
