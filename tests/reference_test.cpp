@@ -639,6 +639,29 @@ void BatchStats(ReferenceEvaluator e, const Vec3d& camera, const Vec3d& dir, con
     }
 }
 
+// Query q of the estimator comparisons: altitude 0, 1, 10, 30, 50 or 120 km
+// (by q), a sun from 12 degrees below the horizon to the zenith and any view
+// direction (from rng).
+struct Query {
+    Vec3d camera, sun, dir;
+    double altitude = 0.0, elevation = 0.0;
+};
+Query MakeQuery(const AtmosphereParameters& atm, int q, Rng& rng) {
+    const double altitudes[] = {0.0, 1e3, 1e4, 3e4, 5e4, 1.2e5};
+    Query query;
+    query.altitude = altitudes[q % 6];
+    query.camera = Vec3d(0.0, 0.0, atm.bottom_radius + query.altitude);
+    const double el = Radians(-12.0 + 102.0 * rng.Uniform());
+    const double az = 2.0 * kPi * rng.Uniform();
+    query.elevation = el;
+    query.sun = Vec3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+    const double mu = 2.0 * rng.Uniform() - 1.0;
+    const double phi = 2.0 * kPi * rng.Uniform();
+    const double s = std::sqrt(1.0 - mu * mu);
+    query.dir = Vec3d(s * std::cos(phi), s * std::sin(phi), mu);
+    return query;
+}
+
 // 240 queries: altitudes 0 to 120 km (and space), any direction, suns from 12
 // degrees below the horizon to the zenith, albedo 0 and 0.3: the hybrid
 // estimator's mean (with `options`) agrees with today's (tracking) within 4
@@ -652,16 +675,9 @@ void ExpectSameIntegralAsTracking(const ReferenceOptions& options) {
         HybridFixture hybrid(atm, 0, options);
         ReferenceEvaluator tracking = MakeReference(atm);
         for (int q = 0; q < 120; ++q) {
-            const double altitudes[] = {0.0, 1e3, 1e4, 3e4, 5e4, 1.2e5};
-            const double alt = altitudes[q % 6];
-            const Vec3d camera(0.0, 0.0, atm.bottom_radius + alt);
-            const double el = Radians(-12.0 + 102.0 * rng.Uniform());
-            const double az = 2.0 * kPi * rng.Uniform();
-            const Vec3d sun(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-            const double mu = 2.0 * rng.Uniform() - 1.0;
-            const double phi = 2.0 * kPi * rng.Uniform();
-            const double s = std::sqrt(1.0 - mu * mu);
-            const Vec3d dir(s * std::cos(phi), s * std::sin(phi), mu);
+            const Query query = MakeQuery(atm, q, rng);
+            const double alt = query.altitude, el = query.elevation, mu = query.dir.z;
+            const Vec3d &camera = query.camera, &sun = query.sun, &dir = query.dir;
             Stats a, b;
             BatchStats(hybrid.e, camera, dir, sun, q, 20, 16, &a);
             BatchStats(tracking, camera, dir, sun, q, 20, 48, &b);
@@ -712,18 +728,10 @@ TEST(ReferenceHybrid, NeeCombAndSunLobeKeepOrderTwo) {
         Rng rng(7, 8, 9);
         int compared = 0, beyond = 0;
         for (int q = 0; q < 120; ++q) {
-            const double altitudes[] = {0.0, 1e3, 1e4, 3e4, 5e4, 1.2e5};
-            const Vec3d camera(0.0, 0.0, atm.bottom_radius + altitudes[q % 6]);
-            const double el = Radians(-12.0 + 102.0 * rng.Uniform());
-            const double az = 2.0 * kPi * rng.Uniform();
-            const Vec3d sun(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
-            const double mu = 2.0 * rng.Uniform() - 1.0;
-            const double phi = 2.0 * kPi * rng.Uniform();
-            const double s = std::sqrt(1.0 - mu * mu);
-            const Vec3d dir(s * std::cos(phi), s * std::sin(phi), mu);
+            const Query query = MakeQuery(atm, q, rng);
             Stats a, b;
-            BatchStats(test.e, camera, dir, sun, q, 20, 32, &a);
-            BatchStats(base.e, camera, dir, sun, q + 1000, 20, 32, &b);
+            BatchStats(test.e, query.camera, query.dir, query.sun, q, 20, 32, &a);
+            BatchStats(base.e, query.camera, query.dir, query.sun, q + 1000, 20, 32, &b);
             for (int c = 0; c < 3; ++c) {
                 const double se = std::hypot(a.StdError()[c], b.StdError()[c]);
                 ++compared;
