@@ -146,7 +146,17 @@ const OptionTable<ReferenceOptions>& ReferenceModel::OptionRows() {
                      "48 for tracking and thesis)")
             .Real("majorant-scale", &O::majorant_scale, 1.0, 64.0, "",
                   "hybrid: factor on the majorants of continuation segments (more, cheaper "
-                  "next-event estimates per path)");
+                  "next-event estimates per path)")
+            .Integer("nee-comb", &O::nee_comb, 0, kMaxNeeComb, "",
+                     "hybrid: stratified uniform next-event points per continuation segment "
+                     "that starts with the sun below its horizon (twilight), MIS-weighted with "
+                     "the collisions' estimates (0: none)")
+            .Real("sun-lobe", &O::sun_lobe, 0.0, 0.95, "",
+                  "hybrid: probability of drawing the first continuation direction from a "
+                  "Henyey-Greenstein lobe around the sun at a first vertex with the sun below "
+                  "its horizon (twilight; MIS with the phase function; 0: none)")
+            .Real("sun-lobe-g", &O::sun_lobe_g, 0.0, 0.99, "",
+                  "hybrid: the sun lobe's Henyey-Greenstein g");
     return table;
 }
 
@@ -162,6 +172,9 @@ ReferenceModel::ReferenceModel(const ReferenceOptions& options) : info_(StaticIn
     evaluator_.estimator = options.estimator;
     evaluator_.spectral = options.estimator != ReferenceEstimator::kThesis;
     evaluator_.continuation_majorant_scale = options.majorant_scale;
+    evaluator_.nee_comb = options.nee_comb;
+    evaluator_.sun_lobe = options.sun_lobe;
+    evaluator_.sun_lobe_g = options.sun_lobe_g;
     sun_disc_light_ = options.sun_disc_light != 0;
     Prepare(EarthAtmosphere());
 }
@@ -177,6 +190,10 @@ void ReferenceModel::Prepare(const AtmosphereParameters& atmosphere) {
     evaluator_.sun_table.tau = sun_table_.view();
     evaluator_.sun_table.bottom = atmosphere.bottom_radius;
     evaluator_.sun_table.top = atmosphere.top_radius;
+    order1_table_ = Table(1, 1, 1, 3);  // until a render computes it
+    order1_key_.clear();
+    evaluator_.order1_table = order1_table_.view();
+    evaluator_.order1_cached = false;
 }
 
 const ReferenceEvaluator& ReferenceModel::evaluator() const {
@@ -198,6 +215,8 @@ std::string ReferenceModel::PassKey() const {
                                                                                : "thesis";
     if (evaluator_.estimator == ReferenceEstimator::kHybrid) {
         key["majorant_scale"] = evaluator_.continuation_majorant_scale;
+        key["nee_comb"] = evaluator_.nee_comb;
+        key["sun_lobe"] = {evaluator_.sun_lobe, evaluator_.sun_lobe_g};
         key["sun_table"] = {kSunTableMuSize, kSunTableRSize, kSunTableIntervals};
     }
     key["sun_cone_cos"] = evaluator_.sun_cone_cos;
@@ -220,10 +239,62 @@ void ReferenceModel::RenderPass(const RenderRequest& request, const MonteCarloPa
         e.sample_count = pass.samples;
         e.need_transmittance = request.sun_disc;  // the only use of T in a radiance pass
     }
-    // The sun table stays on the device from pass to pass.
+    // The sun table (and order 1) stay on the device from pass to pass.
     ResidentScope scope(&resident_);
+    if (request.quantity != Quantity::kTransmittance &&
+        e.estimator == ReferenceEstimator::kHybrid) {
+        e.order1_table = Order1Table(setup, e);
+        e.order1_cached = true;
+    }
     scope.Keep(e);
     RenderImage(e, setup, out->View(), progress);
+}
+
+TableView ReferenceModel::Order1Table(const PixelSetup& setup, const ReferenceEvaluator& e) const {
+    // Deterministic work, the same in every pass: once per request.
+    const Camera& c = setup.camera;
+    std::vector<double> key = {c.position.x,
+                               c.position.y,
+                               c.position.z,
+                               c.forward.x,
+                               c.forward.y,
+                               c.forward.z,
+                               c.right.x,
+                               c.right.y,
+                               c.right.z,
+                               c.up.x,
+                               c.up.y,
+                               c.up.z,
+                               c.tan_half_fov_y,
+                               setup.sun_direction.x,
+                               setup.sun_direction.y,
+                               setup.sun_direction.z,
+                               static_cast<double>(setup.width),
+                               static_cast<double>(setup.height)};
+    std::lock_guard<std::mutex> lock(sun_table_mutex_);
+    if (key != order1_key_) {
+        ReferenceEvaluator first = e;
+        first.max_order = 1;
+        first.sample_begin = 0;
+        first.sample_count = 1;
+        first.order1_cached = false;
+        PixelSetup unit = setup;
+        unit.irradiance = Rgb(1.0f);  // sky + ground per unit irradiance
+        unit.sun_disc = false;
+        Image image;
+        image.Resize(setup.width, setup.height);
+        RenderImage(first, unit, image.View(), nullptr);
+        order1_table_ = Table(setup.width, setup.height, 1, 3);
+        for (int y = 0; y < setup.height; ++y) {
+            for (int x = 0; x < setup.width; ++x) {
+                const Rgb v = image.Get(x, y);
+                float* texel = order1_table_.Texel(x, y);
+                for (int ch = 0; ch < 3; ++ch) texel[ch] = v[ch];
+            }
+        }
+        order1_key_ = key;
+    }
+    return order1_table_.view();
 }
 
 std::vector<SampleAnswer> ReferenceModel::SamplePass(const std::vector<SampleQuery>& queries,

@@ -56,6 +56,7 @@
 #include <stdint.h>
 
 #include <mutex>
+#include <vector>
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
@@ -144,6 +145,8 @@ Vec3d SunOpticalDepthQuadrature(const AtmosphereParameters& atm, double r, doubl
 // intervals in all, at most kHybridMaxNodes nodes.
 constexpr int kHybridViewIntervals = 96;
 constexpr int kHybridMaxNodes = 128;
+// The most next-event comb points per continuation segment.
+constexpr int kMaxNeeComb = 8;
 
 struct ReferenceEvaluator {
     static constexpr bool kStochastic = true;
@@ -171,10 +174,23 @@ struct ReferenceEvaluator {
     // continuation segments' majorants.
     SunTransmittanceTable sun_table;
     double continuation_majorant_scale = 4.0;
+    // kHybrid: uniform next-event points per continuation segment (0: none),
+    // and the first direction's sun lobe (probability, Henyey-Greenstein g).
+    int nee_comb = 0;
+    double sun_lobe = 0.0;
+    double sun_lobe_g = 0.8;
+
+    // kHybrid renders: order 1 of every pixel (sky + ground, per unit
+    // irradiance; width x height x 3, texel (key % width, key / width)),
+    // computed once per request and reused by every pass (order1_cached),
+    // which then skips the view table's sun transmittances and Simpson sums.
+    TableView order1_table;
+    bool order1_cached = false;
 
     template <typename V>
     void VisitTables(V& v) {
         v(sun_table.tau);
+        v(order1_table);
     }
 
     // 1: the sun is a point (directional light, as the other models); < 1: the
@@ -241,8 +257,9 @@ struct ReferenceEvaluator {
     }
 
     // `scale` (>= 1) multiplies the majorants (a looser majorant: see RatioTracking).
-    ATMOS_HD Step Track(Vec3d* p, const Vec3d& dir, int* shell, Rng& rng,
-                        double scale = 1.0) const {
+    // `travelled` (optional) accumulates the distance moved.
+    ATMOS_HD Step Track(Vec3d* p, const Vec3d& dir, int* shell, Rng& rng, double scale = 1.0,
+                        double* travelled = nullptr) const {
         for (int guard = 0; guard < 100000; ++guard) {
             int next;
             const double t_exit = ShellExit(*p, dir, *shell, &next);
@@ -250,9 +267,11 @@ struct ReferenceEvaluator {
             const double t = sigma_bar > 0.0 ? -log(1.0 - rng.Uniform()) / sigma_bar : t_exit + 1.0;
             if (t < t_exit) {
                 *p = *p + dir * t;
+                if (travelled) *travelled += t;
                 return Step::kCollision;
             }
             *p = *p + dir * t_exit;
+            if (travelled) *travelled += t_exit;
             *shell = next;
             if (next < 0) {
                 *p = Normalize(*p) * atm.bottom_radius;
@@ -302,6 +321,52 @@ struct ReferenceEvaluator {
         return t;
     }
 
+    // ---- one tentative collision, shared by TracePath and HybridContinue ----
+    //
+    // Spectral tracking (Kutz et al. 2017): at a tentative collision of a path
+    // of throughput w against the majorant sigma_bar, the events (Rayleigh,
+    // Mie, null) have the masses a_e = mean_c(w_c sigma_e,c); the one chosen
+    // with probability a_e / total multiplies w by sigma_e / (sigma_bar a_e /
+    // total). Absorption is no event: it acts through the weights.
+    struct Collision {
+        Vec3d sigma_r, sigma_m, sigma_n;
+        double sigma_bar, a_r, a_m, a_n, total;
+    };
+    enum class Event { kNull, kRayleigh, kMie };
+
+    ATMOS_HD Collision CollisionAt(const Vec3d& p, double sigma_bar, const Vec3d& w) const {
+        const Densities d = GetDensities(atm, Length(p) - atm.bottom_radius);
+        Collision c;
+        c.sigma_r = atm.rayleigh_scattering * d.rayleigh;
+        c.sigma_m = atm.mie_scattering * d.mie;
+        c.sigma_n = Vec3d(sigma_bar) - Extinction(atm, d);
+        c.sigma_bar = sigma_bar;
+        const double bar = 1.0 / 3.0;
+        c.a_r = Dot(w, c.sigma_r) * bar;
+        c.a_m = Dot(w, c.sigma_m) * bar;
+        c.a_n = Max(Dot(w, c.sigma_n), 0.0) * bar;
+        c.total = c.a_r + c.a_m + c.a_n;
+        return c;
+    }
+
+    // sigma_R P_R(nu) + sigma_M P_M(nu): the light scattered by angle acos(nu).
+    ATMOS_HD Vec3d InScatter(const Vec3d& sigma_r, const Vec3d& sigma_m, double nu) const {
+        return sigma_r * RayleighPhase(nu) + sigma_m * CornetteShanksPhase(atm.mie_phase_g, nu);
+    }
+
+    // Chooses the collision's event and weights w by it (c.total > 0).
+    ATMOS_HD Event ChooseEvent(const Collision& c, Rng& rng, Vec3d* w) const {
+        const double xi = rng.Uniform() * c.total;
+        if (xi >= c.a_r + c.a_m) {
+            *w = *w * c.sigma_n * (1.0 / (c.sigma_bar * (c.a_n / c.total)));
+            return Event::kNull;
+        }
+        const bool rayleigh = xi < c.a_r;
+        *w = *w * (rayleigh ? c.sigma_r : c.sigma_m) *
+             (1.0 / (c.sigma_bar * ((rayleigh ? c.a_r : c.a_m) / c.total)));
+        return rayleigh ? Event::kRayleigh : Event::kMie;
+    }
+
     // One path from `origin` (inside the atmosphere or on its boundary) along
     // `dir`; adds its radiance to *sky (first vertex in the atmosphere) or
     // *ground (first vertex on the ground).
@@ -330,7 +395,6 @@ struct ReferenceEvaluator {
         Vec3d sky_radiance, ground_radiance;
         Vec3d* radiance = &sky_radiance;
         int order = 0;
-        const double bar = 1.0 / 3.0;
         for (int guard = 0; guard < 1000000; ++guard) {
             Step step;
             if (forced_depth > 0.0) {
@@ -371,16 +435,8 @@ struct ReferenceEvaluator {
                 dir = MakeDirection(n, SampleCosineHemisphereCosine(rng.Uniform()), rng.Uniform());
                 w = w * atm.ground_albedo;
             } else {
-                const Densities d = GetDensities(atm, Length(p) - atm.bottom_radius);
-                const Vec3d sigma_r = atm.rayleigh_scattering * d.rayleigh;
-                const Vec3d sigma_m = atm.mie_scattering * d.mie;
-                const double sigma_bar = shells.majorant[shell];
-                const Vec3d sigma_n = Vec3d(sigma_bar) - Extinction(atm, d);
-                const double a_r = Dot(w, sigma_r) * bar;
-                const double a_m = Dot(w, sigma_m) * bar;
-                const double a_n = Max(Dot(w, sigma_n), 0.0) * bar;
-                const double total = a_r + a_m + a_n;
-                if (!(total > 0.0)) break;
+                const Collision c = CollisionAt(p, shells.majorant[shell], w);
+                if (!(c.total > 0.0)) break;
                 // Next-event estimation at every tentative collision, with the
                 // expected value of the event choice: the light scattered here
                 // toward the camera is sigma_s(x) / sigma_bar times its phase
@@ -390,31 +446,17 @@ struct ReferenceEvaluator {
                 // real/null and Rayleigh/Mie coin flips from the direct light.
                 if (max_order == 0 || order < max_order) {
                     const Vec3d light = SunDirection(sun, rng);
-                    const double nu = Dot(dir, light);
-                    const Vec3d scatter = sigma_r * RayleighPhase(nu) +
-                                          sigma_m * CornetteShanksPhase(atm.mie_phase_g, nu);
+                    const Vec3d scatter = InScatter(c.sigma_r, c.sigma_m, Dot(dir, light));
                     if (MaxComponent(w * scatter) > 0.0) {
                         *radiance +=
-                            w * scatter * (1.0 / sigma_bar) * RatioTracking(p, light, shell, rng);
+                            w * scatter * (1.0 / c.sigma_bar) * RatioTracking(p, light, shell, rng);
                     }
                 }
-                const double xi = rng.Uniform() * total;
-                if (xi >= a_r + a_m) {  // null collision: continue straight on
-                    w = w * sigma_n * (1.0 / (sigma_bar * (a_n / total)));
-                    continue;
-                }
-                const bool rayleigh = xi < a_r;
-                w = w * (rayleigh ? sigma_r : sigma_m) *
-                    (1.0 / (sigma_bar * ((rayleigh ? a_r : a_m) / total)));
+                const Event event = ChooseEvent(c, rng, &w);
+                if (event == Event::kNull) continue;  // null collision: continue straight on
                 ++order;
                 if (max_order > 0 && order >= max_order) break;  // its NEE is done
-                if (rayleigh) {
-                    dir = MakeDirection(dir, SampleRayleighCosine(rng.Uniform()), rng.Uniform());
-                } else {
-                    const double mu = SampleHenyeyGreensteinCosine(atm.mie_phase_g, rng.Uniform());
-                    w = w * CornetteShanksOverHenyeyGreenstein(atm.mie_phase_g, mu);
-                    dir = MakeDirection(dir, mu, rng.Uniform());
-                }
+                dir = SamplePhaseDirection(dir, event == Event::kRayleigh, rng, &w);
             }
             // Russian roulette from the 4th vertex on (unlimited orders).
             if (order >= 3) {
@@ -565,8 +607,10 @@ struct ReferenceEvaluator {
     // where the air is. Integrals over t are Simpson's rule in u with the
     // Jacobian dt/du (the integrand times it is smooth, also at u = 0); the
     // optical depth at odd nodes by the 3-point rule h/12 (5 g0 + 8 g1 - g2).
+    // with_order1 false: the table alone (no sun transmittances, *order1 0).
     ATMOS_HD int BuildViewTable(const Vec3d& start, const Vec3d& dir, const Vec3d& sun,
-                                double length, ViewNode* nodes, Vec3d* order1) const {
+                                double length, ViewNode* nodes, Vec3d* order1,
+                                bool with_order1 = true) const {
         double cuts[6];
         int nc = 0;
         cuts[nc++] = 0.0;
@@ -622,7 +666,7 @@ struct ReferenceEvaluator {
                 // The sun's transmittance just inside the piece at its ends
                 // (it jumps at a shadow crossing: each piece takes its side).
                 const double ts = i == 0 ? t + 1e-7 * span : (i == n ? t - 1e-7 * span : t);
-                node.sun_t = SunTransmittanceAt(start + dir * ts, sun);
+                node.sun_t = with_order1 ? SunTransmittanceAt(start + dir * ts, sun) : Vec3d(0.0);
             }
         }
         // Phase 2: optical depths, order 1 and the first-vertex masses.
@@ -636,9 +680,10 @@ struct ReferenceEvaluator {
             // The first node of a later piece is the previous piece's last
             // node, except for its sun transmittance (the other side of a cut).
             const Vec3d sun0 =
-                k == 0 ? nodes[0].sun_t
-                       : SunTransmittanceAt(
-                             start + dir * (cuts[k] + 1e-7 * (cuts[k + 1] - cuts[k])), sun);
+                k == 0 || !with_order1
+                    ? nodes[0].sun_t
+                    : SunTransmittanceAt(start + dir * (cuts[k] + 1e-7 * (cuts[k + 1] - cuts[k])),
+                                         sun);
             // dt/du at the piece's u = 0 (the previous node holds the last
             // piece's value there).
             const bool low_at_a =
@@ -672,6 +717,7 @@ struct ReferenceEvaluator {
                     const double g1 = Dot(sigma_s * Exp(-cur.tau), Vec3d(1.0 / 3.0));
                     cur.cdf = p1.cdf + 0.5 * (cur.t - p1.t) * (g0 + g1);
                 }
+                if (!with_order1) continue;
                 const double wgt = (i == 0 || i == n) ? 1.0 : ((i & 1) ? 4.0 : 2.0);
                 const Vec3d f = (atm.rayleigh_scattering * (node.rho_r * p_r) +
                                  atm.mie_scattering * (node.rho_m * p_m)) *
@@ -685,13 +731,63 @@ struct ReferenceEvaluator {
 
     // Continues a path from a real vertex (direction already sampled): adds
     // every next-event estimate (orders >= order + 1) to *radiance.
+    //
+    // Next-event estimates on each segment (from a real vertex to the ground
+    // or space) come from two point sets, combined by multiple importance
+    // sampling (balance heuristic): the tentative collisions of the tracking
+    // (intensity sigma_bar(t), the continuation majorant; weight w, an
+    // unbiased estimate of the segment's transmittance T(t)), and a comb of
+    // `nee_comb` stratified uniform points over the segment's geometric length
+    // d (intensity n / d), each scored with the path's weight w where the path
+    // reached it (E[w 1(reached t)] = T(t): spectral tracking's transmittance
+    // estimate), nothing beyond the segment's real collision. Both score
+    // w sigma_s P T_sun / (sigma_bar(t) + n / d), so their sum estimates
+    // int T sigma_s P T_sun dt without bias; the comb samples the thin, lit
+    // air where sigma_bar is small and the collisions rare (twilight).
     ATMOS_HD void HybridContinue(Vec3d p, Vec3d dir, Vec3d w, int order, const Vec3d& sun, Rng& rng,
                                  Vec3d* radiance) const {
         int shell = shells.ShellOf(Length(p));
-        const double bar = 1.0 / 3.0;
         const double k = continuation_majorant_scale;
+        // The segment being tracked: its origin, the distance moved along it,
+        // its length, the comb's intensity and points.
+        Vec3d origin = p;
+        double travelled = 0.0, seg_length = 0.0, comb = 0.0;
+        double comb_t[kMaxNeeComb];
+        int comb_n = 0, comb_next = 0;
+        bool new_segment = true;
         for (int guard = 0; guard < 1000000; ++guard) {
-            const Step step = Track(&p, dir, &shell, rng, k);
+            if (new_segment) {
+                new_segment = false;
+                origin = p;
+                travelled = 0.0;
+                comb_n = comb_next = 0;
+                comb = 0.0;
+                // Only where the sun is below the origin's horizon (twilight:
+                // the lit air is thin and far); a choice by the segment's
+                // origin alone, so both strategies stay unbiased.
+                if (nee_comb > 0 && Dot(p, sun) < 0.0) {
+                    const double r = Length(p);
+                    const double mu = ClampCosine(Dot(p, dir) / r);
+                    seg_length = RayIntersectsGround(r, mu, atm.bottom_radius)
+                                     ? DistanceToBottomAtmosphereBoundary(r, mu, atm.bottom_radius)
+                                     : DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius);
+                    if (seg_length > 0.0) {
+                        comb_n = Min(nee_comb, kMaxNeeComb);
+                        comb = comb_n / seg_length;
+                        for (int j = 0; j < comb_n; ++j) {
+                            comb_t[j] = seg_length * (j + rng.Uniform()) / comb_n;
+                        }
+                    }
+                }
+            }
+            const Step step = Track(&p, dir, &shell, rng, k, &travelled);
+            const bool light = max_order == 0 || order < max_order;
+            // The comb's points the path has passed (all, once it leaves the segment).
+            const double reached = step == Step::kCollision ? travelled : seg_length;
+            for (; comb_next < comb_n && comb_t[comb_next] <= reached; ++comb_next) {
+                if (light)
+                    *radiance += w * CombEstimate(origin + dir * comb_t[comb_next], dir, sun, comb);
+            }
             if (step == Step::kEscaped) break;
             if (step == Step::kGround) {
                 ++order;
@@ -705,38 +801,25 @@ struct ReferenceEvaluator {
                 }
                 dir = MakeDirection(n, SampleCosineHemisphereCosine(rng.Uniform()), rng.Uniform());
                 w = w * atm.ground_albedo;
+                new_segment = true;
             } else {
-                const Densities d = GetDensities(atm, Length(p) - atm.bottom_radius);
-                const Vec3d sigma_r = atm.rayleigh_scattering * d.rayleigh;
-                const Vec3d sigma_m = atm.mie_scattering * d.mie;
-                const double sigma_bar = k * shells.majorant[shell];
-                const Vec3d sigma_n = Vec3d(sigma_bar) - Extinction(atm, d);
-                const double a_r = Dot(w, sigma_r) * bar;
-                const double a_m = Dot(w, sigma_m) * bar;
-                const double a_n = Max(Dot(w, sigma_n), 0.0) * bar;
-                const double total = a_r + a_m + a_n;
-                if (!(total > 0.0)) break;
+                const Collision c = CollisionAt(p, k * shells.majorant[shell], w);
+                if (!(c.total > 0.0)) break;
                 // Next-event estimate with the expected value of the event
-                // choice (as TracePath).
-                if (max_order == 0 || order < max_order) {
-                    const double nu = Dot(dir, sun);
-                    const Vec3d scatter = sigma_r * RayleighPhase(nu) +
-                                          sigma_m * CornetteShanksPhase(atm.mie_phase_g, nu);
+                // choice (as TracePath), MIS-weighted against the comb.
+                if (light) {
+                    const Vec3d scatter = InScatter(c.sigma_r, c.sigma_m, Dot(dir, sun));
                     if (MaxComponent(w * scatter) > 0.0) {
-                        *radiance += w * scatter * (1.0 / sigma_bar) * SunTransmittanceAt(p, sun);
+                        *radiance +=
+                            w * scatter * (1.0 / (c.sigma_bar + comb)) * SunTransmittanceAt(p, sun);
                     }
                 }
-                const double xi = rng.Uniform() * total;
-                if (xi >= a_r + a_m) {
-                    w = w * sigma_n * (1.0 / (sigma_bar * (a_n / total)));
-                    continue;
-                }
-                const bool rayleigh = xi < a_r;
-                w = w * (rayleigh ? sigma_r : sigma_m) *
-                    (1.0 / (sigma_bar * ((rayleigh ? a_r : a_m) / total)));
+                const Event event = ChooseEvent(c, rng, &w);
+                if (event == Event::kNull) continue;
                 ++order;
                 if (max_order > 0 && order >= max_order) break;
-                dir = SamplePhaseDirection(dir, rayleigh, rng, &w);
+                dir = SamplePhaseDirection(dir, event == Event::kRayleigh, rng, &w);
+                new_segment = true;
             }
             if (order >= 3) {
                 const double q = Min(0.95, MaxComponent(w));
@@ -744,6 +827,48 @@ struct ReferenceEvaluator {
                 w = w * (1.0 / q);
             }
         }
+    }
+
+    // A comb point's next-event estimate per unit throughput: sigma_s P T_sun
+    // over the sum of both strategies' intensities there.
+    ATMOS_HD Vec3d CombEstimate(const Vec3d& q, const Vec3d& dir, const Vec3d& sun,
+                                double comb) const {
+        const double r = Length(q);
+        const Densities d = GetDensities(atm, r - atm.bottom_radius);
+        const Vec3d scatter = InScatter(atm.rayleigh_scattering * d.rayleigh,
+                                        atm.mie_scattering * d.mie, Dot(dir, sun));
+        if (!(MaxComponent(scatter) > 0.0)) return Vec3d(0.0);
+        const double sigma_bar = continuation_majorant_scale * shells.majorant[shells.ShellOf(r)];
+        return scatter * (1.0 / (sigma_bar + comb)) * SunTransmittanceAt(q, sun);
+    }
+
+    // The first vertex's continuation direction: the phase function, or, at
+    // a vertex x with the sun below its horizon (twilight), with probability
+    // sun_lobe a Henyey-Greenstein lobe (sun_lobe_g) around the sun (one-
+    // sample MIS, balance heuristic: w *= phase / (mixture pdf)).
+    ATMOS_HD Vec3d SampleFirstDirection(const Vec3d& x, const Vec3d& dir, bool rayleigh,
+                                        const Vec3d& sun, Rng& rng, Vec3d* w) const {
+        if (!(sun_lobe > 0.0) || Dot(x, sun) >= 0.0) {
+            return SamplePhaseDirection(dir, rayleigh, rng, w);
+        }
+        const double g = atm.mie_phase_g;
+        Vec3d next;
+        if (rng.Uniform() < sun_lobe) {
+            next = MakeDirection(sun, SampleHenyeyGreensteinCosine(sun_lobe_g, rng.Uniform()),
+                                 rng.Uniform());
+        } else {
+            const double xi = rng.Uniform();
+            next = MakeDirection(
+                dir, rayleigh ? SampleRayleighCosine(xi) : SampleHenyeyGreensteinCosine(g, xi),
+                rng.Uniform());
+        }
+        const double mu = Dot(dir, next);
+        const double phase = rayleigh ? RayleighPhase(mu) : CornetteShanksPhase(g, mu);
+        const double p_phase = rayleigh ? phase : HenyeyGreensteinPhase(g, mu);
+        const double pdf = (1.0 - sun_lobe) * p_phase +
+                           sun_lobe * HenyeyGreensteinPhase(sun_lobe_g, Dot(next, sun));
+        *w = *w * (phase / pdf);
+        return next;
     }
 
     ATMOS_HD Vec3d SamplePhaseDirection(const Vec3d& dir, bool rayleigh, Rng& rng, Vec3d* w) const {
@@ -764,7 +889,7 @@ struct ReferenceEvaluator {
         Vec3d order1;
         int count = 1;
         if (length > 0.0) {
-            count = BuildViewTable(start, dir, sun, length, nodes, &order1);
+            count = BuildViewTable(start, dir, sun, length, nodes, &order1, !order1_cached);
         } else {
             nodes[0] = {0.0, Vec3d(0.0), Vec3d(0.0), 0.0, 0.0, 0.0, 0.0, Vec3d(0.0)};
         }
@@ -775,9 +900,16 @@ struct ReferenceEvaluator {
         const Vec3d t_end = Exp(-tau_end);
         const Vec3d ground_point = start + dir * length;
         const Vec3d normal = Normalize(ground_point);
-        // Order 1 (deterministic).
-        *sky += order1 * static_cast<double>(sample_count);
-        if (reflective) {
+        // Order 1 (deterministic; sky and ground together when cached).
+        if (order1_cached) {
+            const int w = order1_table.width;
+            const Vec4f o = order1_table.Fetch(static_cast<int>(key % static_cast<uint64_t>(w)),
+                                               static_cast<int>(key / static_cast<uint64_t>(w)));
+            *sky += Vec3d(o.x, o.y, o.z) * static_cast<double>(sample_count);
+        } else {
+            *sky += order1 * static_cast<double>(sample_count);
+        }
+        if (reflective && !order1_cached) {
             const double cos_sun = Dot(normal, sun);
             if (cos_sun > 0.0) {
                 *ground += t_end * atm.ground_albedo * (cos_sun / kPi) *
@@ -834,7 +966,7 @@ struct ReferenceEvaluator {
             const bool rayleigh = rng.Uniform() * (a_r + a_m) < a_r;
             Vec3d w =
                 w0 * (rayleigh ? sigma_r * ((a_r + a_m) / a_r) : sigma_m * ((a_r + a_m) / a_m));
-            const Vec3d next = SamplePhaseDirection(dir, rayleigh, rng, &w);
+            const Vec3d next = SampleFirstDirection(x, dir, rayleigh, sun, rng, &w);
             HybridContinue(x, next, w, 1, sun, rng, sky);
         }
     }
@@ -903,6 +1035,9 @@ struct ReferenceOptions {
     int max_order = 0;            // 0: unlimited
     int shells = 0;               // altitude shells of the majorant (0: 8 hybrid, 48 else)
     double majorant_scale = 4.0;  // hybrid: factor on the continuation majorants
+    int nee_comb = 2;             // hybrid: comb points per continuation segment (twilight)
+    double sun_lobe = 0.5;        // hybrid: the first direction's sun-lobe probability (twilight)
+    double sun_lobe_g = 0.8;      // hybrid: its Henyey-Greenstein g
 };
 
 // The sun's optical-depth table of the hybrid estimator: texels along x_mu and
@@ -929,12 +1064,20 @@ class ReferenceModel : public MonteCarloModel {
     const ReferenceEvaluator& evaluator() const;
 
   private:
+    // The order-1 image of a radiance render's pixel setup (computed on its
+    // first pass, a deterministic launch of max-order 1).
+    TableView Order1Table(const PixelSetup& setup, const ReferenceEvaluator& e) const;
+
     ModelInfo info_;
     mutable ReferenceEvaluator evaluator_;
     mutable Table sun_table_;
     mutable bool sun_table_ready_ = false;
     mutable std::mutex sun_table_mutex_;
     mutable ResidentTables resident_;  // the sun table's device copy (render/stages.h)
+    // The hybrid estimator's order-1 image of the last radiance request (its
+    // pixel setup's numbers as the key), reused by every pass of a render.
+    mutable Table order1_table_;
+    mutable std::vector<double> order1_key_;
     int shell_count_ = 48;
     bool sun_disc_light_ = false;
 };
