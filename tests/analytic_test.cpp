@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <random>
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
@@ -217,6 +218,34 @@ double Luminance(const Rgb& c) {
     // Y row of the linear sRGB -> XYZ matrix (IEC 61966-2-1).
     return 0.2126729 * static_cast<double>(c.x) + 0.7151522 * static_cast<double>(c.y) +
            0.0721750 * static_cast<double>(c.z);
+}
+
+// Issue 19: the sun terms computed once per view (PrepareView, what the render
+// loop calls) give the bits of the per-ray ones; a ray of another view ignores them.
+TEST(Preetham, PerViewSunTermsAreBitIdenticalToPerRay) {
+    PreethamModel model{PreethamOptions()};
+    model.Prepare(EarthAtmosphere());
+    const PreethamEvaluator plain = model.MakeEvaluator();
+    std::mt19937 rng(19);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (int view = 0; view < 20; ++view) {
+        const Vec3d camera(0.0, 0.0, plain.bottom + 10.0 * view);
+        const Vec3d sun = Normalize(Vec3d(u(rng), u(rng), view == 0 ? -0.3 : u(rng)));
+        PreethamEvaluator prepared = plain;
+        prepared.PrepareView(camera, sun);
+        const Vec3d other_sun = Normalize(Vec3d(u(rng), u(rng), 0.5));
+        for (int i = 0; i < 200; ++i) {
+            const Vec3d dir = Normalize(Vec3d(u(rng), u(rng), u(rng)));
+            const RayResult a = prepared.Evaluate(camera, dir, sun, true);
+            const RayResult b = plain.Evaluate(camera, dir, sun, true);
+            const RayResult c = prepared.Evaluate(camera, dir, other_sun, true);
+            const RayResult d = plain.Evaluate(camera, dir, other_sun, true);
+            for (int k = 0; k < 3; ++k) {
+                ASSERT_EQ(a.sky[k], b.sky[k]);
+                ASSERT_EQ(c.sky[k], d.sky[k]);
+            }
+        }
+    }
 }
 
 TEST(Preetham, ZenithLuminanceMatchesThePaper) {

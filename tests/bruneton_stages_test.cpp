@@ -84,9 +84,7 @@ Table SyntheticDensity(const BrunetonConfig& c) {
 
 BrunetonLut LutWithTransmittance(const AtmosphereParameters& atm, const BrunetonConfig& c,
                                  Table* transmittance) {
-    BrunetonLut lut;
-    lut.atm = atm;
-    lut.cfg = c;
+    BrunetonLut lut(atm, c);
     transmittance->Resize(c.transmittance_width, c.transmittance_height, 1, 3);
     RunStage("t", static_cast<int64_t>(c.transmittance_width) * c.transmittance_height, 16,
              BrunetonTransmittanceStage{BrunetonMappingsOnly(lut), transmittance->out()});
@@ -338,9 +336,7 @@ TEST(BrunetonStages, EachStageReadsOnlyTheTablesItNames) {
     const int width = c.scattering_nu * c.scattering_mu_s;
     const int64_t texels = static_cast<int64_t>(width) * c.scattering_mu * c.scattering_r;
     const int64_t irr_texels = static_cast<int64_t>(c.irradiance_width) * c.irradiance_height;
-    BrunetonLut lut;
-    lut.atm = atm;
-    lut.cfg = c;
+    BrunetonLut lut(atm, c);
     const BrunetonLut mappings = BrunetonMappingsOnly(lut);
 
     // Every table of the test (pairs: CPU run, emulated run), all poisoned

@@ -22,6 +22,7 @@
 #include "atmos/error.h"
 #include "atmos/model.h"
 #include "models/bruneton.h"
+#include "models/bruneton_stages.h"
 #include "models/naive.h"
 #include "physics/transmittance.h"
 
@@ -126,9 +127,7 @@ TEST(Bruneton, TransmittanceTableMatchesNumericalIntegration) {
 
 TEST(Bruneton, MappingsRoundTrip) {
     const AtmosphereParameters atm = EarthAtmosphere();
-    BrunetonLut lut;
-    lut.atm = atm;
-    lut.cfg = BrunetonConfig();
+    const BrunetonLut lut(atm, BrunetonConfig());
     std::mt19937 rng(2);
     std::uniform_real_distribution<double> u01(0.0, 1.0);
     for (int i = 0; i < 2000; ++i) {
@@ -177,9 +176,7 @@ TEST(Bruneton, MappingsRoundTrip) {
 
 TEST(Bruneton, TexelCentresHoldTheRangeEnds) {
     // Seed 004: texel 0 and n-1 sample the ends of each range exactly.
-    BrunetonLut lut;
-    lut.atm = EarthAtmosphere();
-    lut.cfg = BrunetonConfig();
+    const BrunetonLut lut(EarthAtmosphere(), BrunetonConfig());
     double r, mu, mu_s, nu;
     bool ground;
     const int half = lut.cfg.scattering_mu / 2;
@@ -322,6 +319,70 @@ TEST(Bruneton, OrdersDecreaseAndMultipleScatteringFraction) {
     EXPECT_GT(noon_extra, 0.05);
     EXPECT_LT(noon_extra, 0.30);
     EXPECT_GT(twilight_extra, 2.0 * noon_extra);
+}
+
+// Issue 19: the renderer's lookups (hoisted mapping constants, fixed-layout
+// sampling, one 4D split for both scattering tables) give the same bits as
+// the generic ones (TableView::SampleBilinear / SampleTrilinear, constants
+// computed per call), for both Mie storages, on random queries that include
+// the clamped edges and both halves of the mu range.
+TEST(Bruneton, FastLookupsAreBitIdenticalToTheGenericOnes) {
+    for (const bool combined : {false, true}) {
+        BrunetonConfig c = Small(2);
+        c.combined_mie = combined;
+        const Precomputed p(EarthAtmosphere(), c);
+        const BrunetonLut& lut = p.eval.lut;
+        const double bottom = p.atm.bottom_radius, top = p.atm.top_radius;
+        std::mt19937 rng(19);
+        std::uniform_real_distribution<double> u01(0.0, 1.0);
+        int mismatches = 0;
+        for (int i = 0; i < 20000; ++i) {
+            // r from slightly below the ground to slightly above the top.
+            const double r = bottom - 100.0 + u01(rng) * (top - bottom + 200.0);
+            const double mu = i % 50 == 0 ? (i % 100 == 0 ? -1.0 : 1.0) : 2.0 * u01(rng) - 1.0;
+            const double mu_s = 2.0 * u01(rng) - 1.0;
+            const double nu = 2.0 * u01(rng) - 1.0;
+            const bool ground = u01(rng) < 0.5;
+            double a[4], b[4];
+            lut.ScatteringUvwz(lut.ClampRadius(r), ClampCosine(mu), ClampCosine(mu_s),
+                               ClampCosine(nu), ground, a);
+            lut.ScatteringUvwzGeneric(lut.ClampRadius(r), ClampCosine(mu), ClampCosine(mu_s),
+                                      ClampCosine(nu), ground, b);
+            for (int j = 0; j < 4; ++j) mismatches += a[j] != b[j];
+            const Rgb t = lut.TransmittanceToTop(r, mu), tg = lut.TransmittanceToTopGeneric(r, mu);
+            Rgb m, mg;
+            const Rgb s = lut.CombinedScattering(r, mu, mu_s, nu, ground, &m);
+            const Rgb sg = lut.CombinedScatteringGeneric(r, mu, mu_s, nu, ground, &mg);
+            if (!combined) {
+                // The precomputation's lookup of J_n (models/bruneton_stages.h).
+                const BrunetonFastLookup fast(lut, lut.scattering_table);
+                BrunetonFastLookup::Rows rows;
+                fast.MakeRows(a[2], a[3], &rows);
+                double tex_x;
+                float lerp;
+                BrunetonNuCoordinate(ClampCosine(nu), c.scattering_nu, &tex_x, &lerp);
+                const Rgb f = fast.SampleRows(rows, tex_x, lerp, fast.UMuS(ClampCosine(mu_s)));
+                const Vec4f g = BrunetonLut::Lookup4D(lut.scattering_table, c.scattering_nu, b);
+                mismatches += f.x != g.x || f.y != g.y || f.z != g.z;
+            }
+            const Rgb e = lut.GetIrradiance(lut.irradiance_table, r, mu_s);
+            const Rgb eg = lut.GetIrradianceGeneric(lut.irradiance_table, r, mu_s);
+            for (int j = 0; j < 3; ++j) {
+                mismatches += t[j] != tg[j];
+                mismatches += s[j] != sg[j];
+                mismatches += m[j] != mg[j];
+                mismatches += e[j] != eg[j];
+            }
+            if (mismatches > 0) {
+                ADD_FAILURE() << "combined_mie " << combined << ": query " << i << " r " << r
+                              << " mu " << mu << " mu_s " << mu_s << " nu " << nu << " ground "
+                              << ground << ": T " << t.x << " vs " << tg.x << ", S " << s.x
+                              << " vs " << sg.x << ", M " << m.x << " vs " << mg.x << ", E " << e.x
+                              << " vs " << eg.x;
+                break;
+            }
+        }
+    }
 }
 
 TEST(Bruneton, RayMissingTheAtmosphereAndViewerInSpace) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include <sstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -19,6 +21,7 @@
 #include "atmos/image.h"
 #include "atmos/model.h"
 #include "base/parallel.h"
+#include "io/image_formats.h"
 
 namespace fs = std::filesystem;
 
@@ -157,6 +160,45 @@ TEST(Cli, SampleFollowsTheContract) {
     EXPECT_EQ(header, "altitude_m,mu,mu_s,azimuth_deg,L_r,L_g,L_b,T_r,T_g,T_b");
     EXPECT_EQ(std::count(first.begin(), first.end(), ','), 9);
     EXPECT_NE(second.find(",0,0,0"), std::string::npos) << second;  // hits the ground: T = 0
+}
+
+// Issue 19: --input/--output NPY give the CSV path's answers; the CSV text is
+// printf's ("%.17g" queries, "%.9g" answers) from the buffered printer.
+TEST(Cli, SampleNpyInputAndOutputMatchTheCsv) {
+    const fs::path dir = TempDir();
+    const std::vector<float> q = {0.0f, 1.0f,  1.0f,    0.0f,   1000.0f,  -0.5f,
+                                  0.5f, 30.0f, 2500.0f, 0.125f, 0.03125f, 200.0f};
+    const fs::path in = dir / "q.npy", out = dir / "a.npy";
+    atmos::detail::WriteNpyArray(in.string(), {3, 4}, q.data());
+    const Result npy =
+        RunAtmos("sample --model naive --input " + in.string() + " --output " + out.string(), "");
+    ASSERT_EQ(npy.status, 0) << npy.err;
+    const atmos::detail::NpyArray a = atmos::detail::ReadNpyArray(out.string());
+    ASSERT_EQ(a.shape, (std::vector<std::uint64_t>{3, 6}));
+    const Result csv = RunAtmos("sample --model naive",
+                                "altitude_m,mu,mu_s,azimuth_deg\n0,1,1,0\n1000,-0.5,0.5,30\n"
+                                "2500,0.125,0.03125,200\n");
+    ASSERT_EQ(csv.status, 0) << csv.err;
+    std::istringstream lines(csv.out);
+    std::string line;
+    std::getline(lines, line);
+    for (int i = 0; i < 3; ++i) {
+        ASSERT_TRUE(std::getline(lines, line));
+        std::string expected;
+        char buf[64];
+        for (int c = 0; c < 4; ++c) {
+            std::snprintf(buf, sizeof buf, "%.17g,", static_cast<double>(q[4 * i + c]));
+            expected += buf;
+        }
+        for (int c = 0; c < 6; ++c) {
+            std::snprintf(buf, sizeof buf, "%.9g", a.values[6 * i + c]);
+            expected += buf;
+            if (c < 5) expected += ",";
+        }
+        EXPECT_EQ(line, expected);
+    }
+    ExpectError("sample --model naive --input " + out.string(),
+                "expected an array of shape (N, 4)");
 }
 
 TEST(Cli, ModelOptionsReachTheModel) {

@@ -3,6 +3,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <random>
 
 #include "atmos/error.h"
 #include "base/texture.h"
@@ -42,6 +43,40 @@ TEST(Texture, TrilinearInterpolatesLayers) {
             for (int x = 0; x < 2; ++x) t.Set(x, y, z, {static_cast<float>(z), 1.0f, 0, 0});
     EXPECT_NEAR(t.view().SampleTrilinear(0.5, 0.5, (0.75 + 0.5) / 3.0).x, 0.75, 1e-6);
     EXPECT_FLOAT_EQ(t.view().SampleTrilinear(0.5, 0.5, 0.5).y, 1.0f);
+}
+
+// Issue 19: the fixed-layout samplers (the renderers' lookups) give the bits of
+// the generic ones, at random and out-of-range coordinates, for tables with
+// one or more texels along each axis.
+TEST(Texture, FixedLayoutSamplersAreBitIdenticalToTheGenericOnes) {
+    std::mt19937 rng(19);
+    std::uniform_real_distribution<double> coord(-0.2, 1.2);
+    std::uniform_real_distribution<float> value(0.0f, 3.0f);
+    const int sizes[][3] = {{5, 4, 3}, {1, 2, 2}, {2, 1, 1}, {7, 9, 4}};
+    for (const auto& n : sizes) {
+        Table t3(n[0], n[1], n[2], 3), t4(n[0], n[1], n[2], 4);
+        for (size_t i = 0; i < t3.size(); ++i) t3.data()[i] = value(rng);
+        for (size_t i = 0; i < t4.size(); ++i) t4.data()[i] = value(rng);
+        const TableView v3 = t3.view(), v4 = t4.view();
+        for (int i = 0; i < 2000; ++i) {
+            const double u = i % 97 == 0 ? 1.0 : coord(rng), v = coord(rng), w = coord(rng);
+            const Rgb fixed = SampleBilinearRgb(v3, u, v);
+            const Rgb generic = v3.SampleBilinear(u, v).rgb();
+            for (int c = 0; c < 3; ++c) ASSERT_EQ(fixed[c], generic[c]) << u << " " << v;
+            const TexelSpan x = SplitSpan(u, n[0]), y = SplitSpan(v, n[1]), z = SplitSpan(w, n[2]);
+            float f3[3], f4[4];
+            SampleTrilinearFixed<3>(v3.data, n[0], n[1], x, y, z, f3);
+            SampleTrilinearFixed<4>(v4.data, n[0], n[1], x, y, z, f4);
+            const Vec4f g3 = v3.SampleTrilinear(u, v, w), g4 = v4.SampleTrilinear(u, v, w);
+            ASSERT_EQ(f3[0], g3.x);
+            ASSERT_EQ(f3[1], g3.y);
+            ASSERT_EQ(f3[2], g3.z);
+            ASSERT_EQ(f4[0], g4.x);
+            ASSERT_EQ(f4[1], g4.y);
+            ASSERT_EQ(f4[2], g4.z);
+            ASSERT_EQ(f4[3], g4.w);
+        }
+    }
 }
 
 TEST(TableIo, ExrRoundTripIsExact) {

@@ -37,6 +37,16 @@ ATMOS_HD inline double GetUnitRangeFromTextureCoord(double u, int texture_size) 
     return (u - 0.5 / texture_size) / (1.0 - 1.0 / texture_size);
 }
 
+// GetTextureCoordFromUnitRange for one texture size, its two divisions done
+// once (the same values, hence bit-identical results).
+struct TexelCentreMap {
+    double offset = 0.0, scale = 1.0;
+    TexelCentreMap() = default;
+    ATMOS_HD explicit TexelCentreMap(int texture_size)
+        : offset(0.5 / texture_size), scale(1.0 - 1.0 / texture_size) {}
+    ATMOS_HD double operator()(double x) const { return offset + x * scale; }
+};
+
 // A non-owning, trivially copyable view of a table (device-copyable when
 // `data` points to device memory).
 struct TableView {
@@ -91,6 +101,61 @@ struct TableView {
         *f = size > 1 ? static_cast<float>(x - i) : 0.0f;
     }
 };
+
+// One axis of a filtered lookup: the two texels (the upper one clamped to the
+// edge, as TableView::Fetch clamps it) and the fraction (TableView::Split).
+struct TexelSpan {
+    int i0 = 0, i1 = 0;
+    float f = 0.0f;
+};
+ATMOS_HD inline TexelSpan SplitSpan(double u, int size) {
+    TexelSpan s;
+    TableView::Split(u, size, &s.i0, &s.f);
+    s.i1 = Min(s.i0 + 1, size - 1);
+    return s;
+}
+
+// TableView::SampleBilinear specialised for a table of C channels, from the
+// spans of both axes (computed once for every table of the same size): the
+// same operations in the same order, hence bit-identical; no per-texel clamps
+// or channel tests. `row0` and `row1`: texel indices of (0, y0) and (0, y1).
+template <int C>
+ATMOS_HD inline float BilinearChannel(const float* data, size_t row0, size_t row1,
+                                      const TexelSpan& x, float fy, int c) {
+    const float a = data[(row0 + x.i0) * C + c] * (1.0f - x.f) + data[(row0 + x.i1) * C + c] * x.f;
+    const float b = data[(row1 + x.i0) * C + c] * (1.0f - x.f) + data[(row1 + x.i1) * C + c] * x.f;
+    return a * (1.0f - fy) + b * fy;
+}
+// A 2D table's (layer 0) bilinear lookup at the spans x, y: C channels to out.
+template <int C>
+ATMOS_HD inline void SampleBilinearFixed(const float* data, int width, const TexelSpan& x,
+                                         const TexelSpan& y, float out[C]) {
+    const size_t row0 = static_cast<size_t>(y.i0) * width;
+    const size_t row1 = static_cast<size_t>(y.i1) * width;
+    for (int c = 0; c < C; ++c) out[c] = BilinearChannel<C>(data, row0, row1, x, y.f, c);
+}
+// SampleBilinear(u, v).rgb() of a 3-channel 2D table, bit-identical.
+ATMOS_HD inline Rgb SampleBilinearRgb(const TableView& t, double u, double v) {
+    ATMOS_DASSERT(t.channels == 3);
+    float o[3];
+    SampleBilinearFixed<3>(t.data, t.width, SplitSpan(u, t.width), SplitSpan(v, t.height), o);
+    return Rgb(o[0], o[1], o[2]);
+}
+
+// SampleTrilinear(u, v, w) of a C-channel table at the spans of its three
+// axes (shared by tables of the same size), bit-identical.
+template <int C>
+ATMOS_HD inline void SampleTrilinearFixed(const float* data, int width, int height,
+                                          const TexelSpan& x, const TexelSpan& y,
+                                          const TexelSpan& z, float out[C]) {
+    const size_t w = static_cast<size_t>(width), h = static_cast<size_t>(height);
+    const size_t r00 = (z.i0 * h + y.i0) * w, r01 = (z.i0 * h + y.i1) * w;
+    const size_t r10 = (z.i1 * h + y.i0) * w, r11 = (z.i1 * h + y.i1) * w;
+    for (int c = 0; c < C; ++c) {
+        out[c] = BilinearChannel<C>(data, r00, r01, x, y.f, c) * (1.0f - z.f) +
+                 BilinearChannel<C>(data, r10, r11, x, y.f, c) * z.f;
+    }
+}
 
 // A non-owning, trivially copyable, writable view of a table: what a
 // precomputation stage (render/stages.h) writes its output through, on the host

@@ -33,6 +33,17 @@ void WritePngBytes(const std::vector<std::uint8_t>& bytes, int width, int height
 // (grey).
 void WriteNpy(const Image& image, const std::string& path);
 Image ReadNpy(const std::string& path);
+// Any C-order array: written as '<f4' of `shape` from `data` (row-major), read
+// from '<f4' or '<f8' as doubles (the image functions above are these plus
+// their shape checks; `atmos sample --input/--output` uses them for tables).
+struct NpyArray {
+    std::vector<std::uint64_t> shape;
+    std::vector<double> values;
+};
+void WriteNpyArray(const std::string& path, const std::vector<std::uint64_t>& shape,
+                   const float* data);
+NpyArray ReadNpyArray(const std::string& path);
+std::string NpyShapeString(const std::vector<std::uint64_t>& shape);
 
 // Portable float map: writes "PF" (colour), little-endian, rows bottom to top.
 // Reads "PF" and "Pf" (grey) of either byte order.

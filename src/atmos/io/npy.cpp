@@ -153,10 +153,10 @@ std::string ShapeString(const std::vector<std::uint64_t>& shape) {
 
 }  // namespace
 
-void WriteNpy(const Image& image, const std::string& path) {
-    std::string dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (" +
-                       std::to_string(image.height()) + ", " + std::to_string(image.width()) +
-                       ", 3), }";
+void WriteNpyArray(const std::string& path, const std::vector<std::uint64_t>& shape,
+                   const float* data) {
+    std::string dict =
+        "{'descr': '<f4', 'fortran_order': False, 'shape': " + ShapeString(shape) + ", }";
     // Version 1.0 unless the header would not fit its 16-bit length field.
     size_t prefix = kMagicSize + 2 + 2;
     size_t total = prefix + dict.size() + 1;  // + '\n'
@@ -179,15 +179,16 @@ void WriteNpy(const Image& image, const std::string& path) {
     }
     prelude += dict;
 
+    size_t count = 1;
+    for (const std::uint64_t d : shape) count *= static_cast<size_t>(d);
     const size_t data_start = prelude.size();
-    std::vector<std::uint8_t> bytes(data_start + image.size() * 4);
+    std::vector<std::uint8_t> bytes(data_start + count * 4);
     std::memcpy(bytes.data(), prelude.data(), data_start);
-    const float* src = image.data();
-    for (size_t i = 0; i < image.size(); ++i) StoreF32Le(src[i], &bytes[data_start + 4 * i]);
+    for (size_t i = 0; i < count; ++i) StoreF32Le(data[i], &bytes[data_start + 4 * i]);
     WriteFileBytes(path, bytes);
 }
 
-Image ReadNpy(const std::string& path) {
+NpyArray ReadNpyArray(const std::string& path) {
     const std::vector<std::uint8_t> bytes = ReadFileBytes(path);
     if (bytes.size() < kMagicSize + 4 || std::memcmp(bytes.data(), kMagic, kMagicSize) != 0) {
         Fail("cannot read NPY '", path, "': not a NumPy .npy file (bad magic)");
@@ -226,7 +227,46 @@ Image ReadNpy(const std::string& path) {
     if (header.fortran_order) {
         Fail("cannot read NPY '", path, "': Fortran-order arrays are not supported");
     }
-    const std::vector<std::uint64_t>& shape = header.shape;
+    std::uint64_t count = 1;
+    for (const std::uint64_t d : header.shape) {
+        if (d > 0 && count > (std::uint64_t{1} << 36) / d) {
+            Fail("cannot read NPY '", path, "': unsupported size ", ShapeString(header.shape));
+        }
+        count *= d;
+    }
+    const std::uint64_t data_bytes = count * item_size;
+    const std::uint64_t available = bytes.size() - prefix - header_len;
+    if (available < data_bytes) {
+        Fail("cannot read NPY '", path, "': truncated data (", available, " bytes of ", data_bytes,
+             " for shape ", ShapeString(header.shape), ")");
+    }
+    if (available > data_bytes) {
+        Fail("cannot read NPY '", path, "': ", available - data_bytes,
+             " unexpected bytes after the array data");
+    }
+    NpyArray array;
+    array.shape = header.shape;
+    array.values.resize(static_cast<size_t>(count));
+    const std::uint8_t* src = bytes.data() + prefix + header_len;
+    for (size_t i = 0; i < array.values.size(); ++i) {
+        const std::uint8_t* q = src + i * item_size;
+        array.values[i] = item_size == 4 ? static_cast<double>(LoadF32(q, true)) : LoadF64(q, true);
+    }
+    return array;
+}
+
+std::string NpyShapeString(const std::vector<std::uint64_t>& shape) { return ShapeString(shape); }
+
+void WriteNpy(const Image& image, const std::string& path) {
+    WriteNpyArray(
+        path,
+        {static_cast<std::uint64_t>(image.height()), static_cast<std::uint64_t>(image.width()), 3},
+        image.data());
+}
+
+Image ReadNpy(const std::string& path) {
+    const NpyArray array = ReadNpyArray(path);
+    const std::vector<std::uint64_t>& shape = array.shape;
     std::uint64_t channels = 0;
     if (shape.size() == 2) {
         channels = 1;
@@ -242,27 +282,13 @@ Image ReadNpy(const std::string& path) {
         height * width > (std::uint64_t{1} << 34)) {
         Fail("cannot read NPY '", path, "': unsupported image size ", ShapeString(shape));
     }
-    const std::uint64_t data_bytes = height * width * channels * item_size;
-    const std::uint64_t available = bytes.size() - prefix - header_len;
-    if (available < data_bytes) {
-        Fail("cannot read NPY '", path, "': truncated data (", available, " bytes of ", data_bytes,
-             " for shape ", ShapeString(shape), ")");
-    }
-    if (available > data_bytes) {
-        Fail("cannot read NPY '", path, "': ", available - data_bytes,
-             " unexpected bytes after the array data");
-    }
-
     Image image(static_cast<int>(width), static_cast<int>(height));
-    const std::uint8_t* src = bytes.data() + prefix + header_len;
     float* out = image.data();
     const size_t pixels = static_cast<size_t>(width * height);
     for (size_t p = 0; p < pixels; ++p) {
         for (size_t c = 0; c < 3; ++c) {
             const size_t k = c < channels ? c : 0;  // grey: replicate channel 0
-            const std::uint8_t* q = src + (p * channels + k) * item_size;
-            out[3 * p + c] =
-                item_size == 4 ? LoadF32(q, true) : static_cast<float>(LoadF64(q, true));
+            out[3 * p + c] = static_cast<float>(array.values[p * channels + k]);
         }
     }
     return image;

@@ -90,9 +90,92 @@ ATMOS_HD inline double BrunetonQuadratureWeight(int rule, int i, int n) {
     return w;
 }
 
+// The mappings' constants, which depend on the atmosphere and the table sizes
+// only: computed once (BrunetonLut's constructor) instead of per query, by the
+// same operations as the seed's per-query code (bit-identical results).
+struct BrunetonConstants {
+    double bottom = 0.0, top = 0.0;
+    double bottom2 = 0.0;  // bottom^2
+    double H = 0.0;        // HorizonH()
+    double H2 = 0.0;       // H^2
+    // u_mu_s (ScatteringUMuS): d_min, d_max - d_min and A.
+    double mu_s_d_min = 0.0, mu_s_d_range = 1.0, mu_s_big_a = 1.0;
+    double irradiance_r_range = 1.0;  // top - bottom
+    TexelCentreMap transmittance_u, transmittance_v, irradiance_u, irradiance_v;
+    TexelCentreMap scattering_r, scattering_mu_half, scattering_mu_s;
+};
+
+// The mu_s part of GetScatteringTextureUvwzFromRMuMuSNu from the constants.
+ATMOS_HD inline double BrunetonUMuS(const BrunetonConstants& k, double mu_s) {
+    ATMOS_DASSERT(k.H > 0.0);
+    const double d = DistanceToTopAtmosphereBoundary(k.bottom, mu_s, k.top);
+    const double a = (d - k.mu_s_d_min) / k.mu_s_d_range;
+    return k.scattering_mu_s(Max(1.0 - a / k.mu_s_big_a, 0.0) / (1.0 + a));
+}
+
+// A 4D lookup's texels and weights (BrunetonLut::Lookup4D: two trilinear
+// lookups at u0 and u1), in two parts: the (mu, r) rows and the (nu, mu_s)
+// columns. Computed once per query and shared by the tables of the same
+// layout (scattering and single Mie); the precomputation's multiple
+// scattering computes the rows once per view-ray sample for a row of texels.
+struct Bruneton4DRows {
+    size_t row[4];  // texel index of x = 0 in rows (y0,z0) (y1,z0) (y0,z1) (y1,z1)
+    float fy, fz;   // along y and z
+};
+struct Bruneton4DColumns {
+    TexelSpan xa, xb;  // along x at u0 and u1
+    float lerp;        // between the two
+};
+ATMOS_HD inline Bruneton4DRows BrunetonSplitRows(int width, int height, int depth, double u_mu,
+                                                 double u_r) {
+    const TexelSpan y = SplitSpan(u_mu, height);
+    const TexelSpan z = SplitSpan(u_r, depth);
+    Bruneton4DRows s;
+    s.fy = y.f;
+    s.fz = z.f;
+    const size_t w = static_cast<size_t>(width), h = static_cast<size_t>(height);
+    s.row[0] = (z.i0 * h + y.i0) * w;
+    s.row[1] = (z.i0 * h + y.i1) * w;
+    s.row[2] = (z.i1 * h + y.i0) * w;
+    s.row[3] = (z.i1 * h + y.i1) * w;
+    return s;
+}
+// The nu coordinate: tex_x = floor(u_nu (NU - 1)) and lerp its fraction.
+ATMOS_HD inline void BrunetonNuCoordinate(double nu, int nu_size, double* tex_x, float* lerp) {
+    const double tex_coord_x = (nu + 1.0) / 2.0 * (nu_size - 1);
+    *tex_x = floor(tex_coord_x);
+    *lerp = static_cast<float>(tex_coord_x - *tex_x);
+}
+ATMOS_HD inline Bruneton4DColumns BrunetonSplitColumns(int width, int nu_size, double tex_x,
+                                                       float lerp, double u_mu_s) {
+    Bruneton4DColumns s;
+    s.lerp = lerp;
+    const double u0 = (tex_x + u_mu_s) / nu_size;
+    const double u1 = (tex_x + 1.0 + u_mu_s) / nu_size;
+    s.xa = SplitSpan(u0, width);
+    s.xb = SplitSpan(u1, width);
+    return s;
+}
+// Lookup4D of a C-channel table at (rows, columns): the operations of
+// SampleTrilinear / SampleBilinear in their order (bit-identical).
+template <int C>
+ATMOS_HD inline void BrunetonSample4D(const float* data, const Bruneton4DRows& r,
+                                      const Bruneton4DColumns& x, float out[C]) {
+    for (int c = 0; c < C; ++c) {
+        const float ta =
+            BilinearChannel<C>(data, r.row[0], r.row[1], x.xa, r.fy, c) * (1.0f - r.fz) +
+            BilinearChannel<C>(data, r.row[2], r.row[3], x.xa, r.fy, c) * r.fz;
+        const float tb =
+            BilinearChannel<C>(data, r.row[0], r.row[1], x.xb, r.fy, c) * (1.0f - r.fz) +
+            BilinearChannel<C>(data, r.row[2], r.row[3], x.xb, r.fy, c) * r.fz;
+        out[c] = ta * (1.0f - x.lerp) + tb * x.lerp;
+    }
+}
+
 // The lookup functions of seed 004 over a set of tables (trivially copyable;
 // used both by the precomputation, over its intermediate tables, and by the
-// renderer, over the final ones). Every function is ATMOS_HD.
+// renderer, over the final ones). Every function is ATMOS_HD. Construct it
+// from (atmosphere, config): the constructor computes `k`.
 struct BrunetonLut {
     AtmosphereParameters atm;
     BrunetonConfig cfg;
@@ -100,6 +183,30 @@ struct BrunetonLut {
     TableView irradiance_table;     // 3 channels (indirect only, as the seed)
     TableView scattering_table;     // 3 channels (separate) or 4 (combined)
     TableView single_mie_table;     // 3 channels, separate storage only
+    BrunetonConstants k;            // of atm and cfg
+
+    BrunetonLut() = default;
+    BrunetonLut(const AtmosphereParameters& atmosphere, const BrunetonConfig& config)
+        : atm(atmosphere), cfg(config) {
+        k.bottom = atm.bottom_radius;
+        k.top = atm.top_radius;
+        k.bottom2 = atm.bottom_radius * atm.bottom_radius;
+        k.H = HorizonH();
+        k.H2 = k.H * k.H;
+        k.mu_s_d_min = atm.top_radius - atm.bottom_radius;
+        k.mu_s_d_range = k.H - k.mu_s_d_min;
+        const double D =
+            DistanceToTopAtmosphereBoundary(atm.bottom_radius, atm.mu_s_min, atm.top_radius);
+        k.mu_s_big_a = (D - k.mu_s_d_min) / k.mu_s_d_range;
+        k.irradiance_r_range = atm.top_radius - atm.bottom_radius;
+        k.transmittance_u = TexelCentreMap(cfg.transmittance_width);
+        k.transmittance_v = TexelCentreMap(cfg.transmittance_height);
+        k.irradiance_u = TexelCentreMap(cfg.irradiance_width);
+        k.irradiance_v = TexelCentreMap(cfg.irradiance_height);
+        k.scattering_r = TexelCentreMap(cfg.scattering_r);
+        k.scattering_mu_half = TexelCentreMap(cfg.scattering_mu / 2);
+        k.scattering_mu_s = TexelCentreMap(cfg.scattering_mu_s);
+    }
 
     // Names every table (render/stages.h: a stage holding a lut copies these).
     template <typename V>
@@ -127,8 +234,21 @@ struct BrunetonLut {
     }
 
     // ---- transmittance (seed 004, "Precomputation" / "Lookup" of transmittance) ----
-    // GetTransmittanceTextureUvFromRMu.
+    // GetTransmittanceTextureUvFromRMu, with the constants of k.
     ATMOS_HD void TransmittanceUvFromRMu(double r, double mu, double* u, double* v) const {
+        ATMOS_DASSERT(k.H > 0.0);
+        const double rho = SafeSqrt(r * r - k.bottom2);
+        const double d = DistanceToTopAtmosphereBoundary(r, mu, k.top);
+        const double d_min = k.top - r;
+        const double d_max = rho + k.H;
+        const double x_mu = (d - d_min) / (d_max - d_min);
+        const double x_r = rho / k.H;
+        *u = k.transmittance_u(x_mu);
+        *v = k.transmittance_v(x_r);
+    }
+    // The same, everything computed per call (the seed's form; tests hold the
+    // hoisted one against it).
+    ATMOS_HD void TransmittanceUvFromRMuGeneric(double r, double mu, double* u, double* v) const {
         const double H = HorizonH();
         const double rho = SafeSqrt(r * r - atm.bottom_radius * atm.bottom_radius);
         const double d = DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius);
@@ -152,10 +272,16 @@ struct BrunetonLut {
         const double m = d == 0.0 ? 1.0 : (H * H - rho * rho - d * d) / (2.0 * *r * d);
         *mu = ClampCosine(m);
     }
-    // GetTransmittanceToTopAtmosphereBoundary: one lookup.
+    // GetTransmittanceToTopAtmosphereBoundary: one lookup (fixed layout).
     ATMOS_HD Rgb TransmittanceToTop(double r, double mu) const {
         double u, v;
         TransmittanceUvFromRMu(ClampRadius(r), ClampCosine(mu), &u, &v);
+        return SampleBilinearRgb(transmittance_table, u, v);
+    }
+    // The generic form (TableView::SampleBilinear, per-call constants).
+    ATMOS_HD Rgb TransmittanceToTopGeneric(double r, double mu) const {
+        double u, v;
+        TransmittanceUvFromRMuGeneric(ClampRadius(r), ClampCosine(mu), &u, &v);
         return transmittance_table.SampleBilinear(u, v).rgb();
     }
     // GetTransmittance between (r, mu) and the point at distance d along the ray;
@@ -185,8 +311,31 @@ struct BrunetonLut {
     }
 
     // ---- scattering table mapping (seed 004, "Precomputation" of single scattering) ----
-    // The mu_s part of GetScatteringTextureUvwzFromRMuMuSNu.
-    ATMOS_HD double ScatteringUMuS(double mu_s) const {
+    // The mu_s part of GetScatteringTextureUvwzFromRMuMuSNu (constants of k).
+    ATMOS_HD double ScatteringUMuS(double mu_s) const { return BrunetonUMuS(k, mu_s); }
+    // The (mu, r) part: v = u_mu, w = u_r (constants of k).
+    ATMOS_HD void ScatteringUMuR(double r, double mu, bool ray_r_mu_intersects_ground, double* u_mu,
+                                 double* u_r) const {
+        ATMOS_DASSERT(k.H > 0.0);
+        const double rho = SafeSqrt(r * r - k.bottom2);
+        *u_r = k.scattering_r(rho / k.H);
+        const double r_mu = r * mu;
+        const double discriminant = r_mu * r_mu - r * r + k.bottom2;
+        if (ray_r_mu_intersects_ground) {
+            const double d = -r_mu - SafeSqrt(discriminant);
+            const double d_min = r - k.bottom;
+            const double d_max = rho;
+            const double x = d_max == d_min ? 0.0 : (d - d_min) / (d_max - d_min);
+            *u_mu = 0.5 - 0.5 * k.scattering_mu_half(x);
+        } else {
+            const double d = -r_mu + SafeSqrt(discriminant + k.H2);
+            const double d_min = k.top - r;
+            const double d_max = rho + k.H;
+            *u_mu = 0.5 + 0.5 * k.scattering_mu_half((d - d_min) / (d_max - d_min));
+        }
+    }
+    // The generic forms of the two (per-call constants; for the tests).
+    ATMOS_HD double ScatteringUMuSGeneric(double mu_s) const {
         const double H = HorizonH();
         const double d = DistanceToTopAtmosphereBoundary(atm.bottom_radius, mu_s, atm.top_radius);
         const double d_min = atm.top_radius - atm.bottom_radius;
@@ -197,9 +346,8 @@ struct BrunetonLut {
         const double A = (D - d_min) / (d_max - d_min);
         return GetTextureCoordFromUnitRange(Max(1.0 - a / A, 0.0) / (1.0 + a), cfg.scattering_mu_s);
     }
-    // The (mu, r) part: v = u_mu, w = u_r.
-    ATMOS_HD void ScatteringUMuR(double r, double mu, bool ray_r_mu_intersects_ground, double* u_mu,
-                                 double* u_r) const {
+    ATMOS_HD void ScatteringUMuRGeneric(double r, double mu, bool ray_r_mu_intersects_ground,
+                                        double* u_mu, double* u_r) const {
         const double H = HorizonH();
         const double rho = SafeSqrt(r * r - atm.bottom_radius * atm.bottom_radius);
         *u_r = GetTextureCoordFromUnitRange(rho / H, cfg.scattering_r);
@@ -226,6 +374,12 @@ struct BrunetonLut {
                                  bool ray_r_mu_intersects_ground, double uvwz[4]) const {
         ScatteringUMuR(r, mu, ray_r_mu_intersects_ground, &uvwz[2], &uvwz[3]);
         uvwz[1] = ScatteringUMuS(mu_s);
+        uvwz[0] = (nu + 1.0) / 2.0;
+    }
+    ATMOS_HD void ScatteringUvwzGeneric(double r, double mu, double mu_s, double nu,
+                                        bool ray_r_mu_intersects_ground, double uvwz[4]) const {
+        ScatteringUMuRGeneric(r, mu, ray_r_mu_intersects_ground, &uvwz[2], &uvwz[3]);
+        uvwz[1] = ScatteringUMuSGeneric(mu_s);
         uvwz[0] = (nu + 1.0) / 2.0;
     }
     // GetRMuMuSNuFromScatteringTextureUvwz (the inverse).
@@ -305,12 +459,42 @@ struct BrunetonLut {
         return s.rgb() * (s.w / s.x) * Rgb(ratio);
     }
     // Seed 004 GetCombinedScattering: Rayleigh + multiple scattering, and the
-    // single Mie scattering (without phase functions).
+    // single Mie scattering (without phase functions). One split for both
+    // tables, fixed-layout lookups.
     ATMOS_HD Rgb CombinedScattering(double r, double mu, double mu_s, double nu,
                                     bool ray_r_mu_intersects_ground, Rgb* single_mie) const {
         double uvwz[4];
         ScatteringUvwz(ClampRadius(r), ClampCosine(mu), ClampCosine(mu_s), ClampCosine(nu),
                        ray_r_mu_intersects_ground, uvwz);
+        const TableView& t = scattering_table;
+        const Bruneton4DRows rows = BrunetonSplitRows(t.width, t.height, t.depth, uvwz[2], uvwz[3]);
+        const double tex_coord_x = uvwz[0] * (cfg.scattering_nu - 1);
+        const double tex_x = floor(tex_coord_x);
+        const Bruneton4DColumns cols = BrunetonSplitColumns(
+            t.width, cfg.scattering_nu, tex_x, static_cast<float>(tex_coord_x - tex_x), uvwz[1]);
+        if (cfg.combined_mie) {
+            float c[4];
+            BrunetonSample4D<4>(t.data, rows, cols, c);
+            Vec4f s;
+            s.x = c[0];
+            s.y = c[1];
+            s.z = c[2];
+            s.w = c[3];
+            *single_mie = ExtrapolatedSingleMie(s);
+            return s.rgb();
+        }
+        float s[3], m[3];
+        BrunetonSample4D<3>(t.data, rows, cols, s);
+        BrunetonSample4D<3>(single_mie_table.data, rows, cols, m);
+        *single_mie = Rgb(m[0], m[1], m[2]);
+        return Rgb(s[0], s[1], s[2]);
+    }
+    // The generic form (TableView::SampleTrilinear, per-call constants).
+    ATMOS_HD Rgb CombinedScatteringGeneric(double r, double mu, double mu_s, double nu,
+                                           bool ray_r_mu_intersects_ground, Rgb* single_mie) const {
+        double uvwz[4];
+        ScatteringUvwzGeneric(ClampRadius(r), ClampCosine(mu), ClampCosine(mu_s), ClampCosine(nu),
+                              ray_r_mu_intersects_ground, uvwz);
         const Vec4f s = Lookup4D(scattering_table, cfg.scattering_nu, uvwz);
         if (cfg.combined_mie) {
             *single_mie = ExtrapolatedSingleMie(s);
@@ -322,6 +506,13 @@ struct BrunetonLut {
 
     // ---- irradiance (seed 004, "Ground irradiance") ----
     ATMOS_HD void IrradianceUvFromRMuS(double r, double mu_s, double* u, double* v) const {
+        ATMOS_DASSERT(k.H > 0.0);
+        const double x_r = (r - k.bottom) / k.irradiance_r_range;
+        const double x_mu_s = mu_s * 0.5 + 0.5;
+        *u = k.irradiance_u(x_mu_s);
+        *v = k.irradiance_v(x_r);
+    }
+    ATMOS_HD void IrradianceUvFromRMuSGeneric(double r, double mu_s, double* u, double* v) const {
         const double x_r = (r - atm.bottom_radius) / (atm.top_radius - atm.bottom_radius);
         const double x_mu_s = mu_s * 0.5 + 0.5;
         *u = GetTextureCoordFromUnitRange(x_mu_s, cfg.irradiance_width);
@@ -333,9 +524,16 @@ struct BrunetonLut {
         *r = atm.bottom_radius + x_r * (atm.top_radius - atm.bottom_radius);
         *mu_s = ClampCosine(2.0 * x_mu_s - 1.0);
     }
+    // A 3-channel irradiance table (fixed layout).
     ATMOS_HD Rgb GetIrradiance(const TableView& table, double r, double mu_s) const {
+        ATMOS_DASSERT(table.channels == 3);
         double u, v;
         IrradianceUvFromRMuS(ClampRadius(r), ClampCosine(mu_s), &u, &v);
+        return SampleBilinearRgb(table, u, v);
+    }
+    ATMOS_HD Rgb GetIrradianceGeneric(const TableView& table, double r, double mu_s) const {
+        double u, v;
+        IrradianceUvFromRMuSGeneric(ClampRadius(r), ClampCosine(mu_s), &u, &v);
         return table.SampleBilinear(u, v).rgb();
     }
     // Seed 004 ComputeDirectIrradiance (per unit solar irradiance): the average

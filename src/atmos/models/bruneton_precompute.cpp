@@ -44,9 +44,7 @@ void ValidateBrunetonConfig(const BrunetonConfig& c) {
 
 BrunetonLut MakeBrunetonLut(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
                             const BrunetonTables& tables) {
-    BrunetonLut lut;
-    lut.atm = atmosphere;
-    lut.cfg = config;
+    BrunetonLut lut(atmosphere, config);
     lut.transmittance_table = tables.transmittance.view();
     lut.irradiance_table = tables.irradiance.view();
     lut.scattering_table = tables.scattering.view();
@@ -175,9 +173,7 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
                             bool texel_stages, BrunetonTables* tables,
                             const BrunetonOrderCallback& on_order) {
     ValidateBrunetonConfig(config);
-    BrunetonLut lut;
-    lut.atm = atmosphere;
-    lut.cfg = config;
+    BrunetonLut lut(atmosphere, config);
     const BrunetonLut mappings = BrunetonMappingsOnly(lut);
     const int width = config.scattering_nu * config.scattering_mu_s;
     // On a device backend all tables stay on the device between the stages;

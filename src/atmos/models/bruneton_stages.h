@@ -45,10 +45,7 @@ ATMOS_HD inline void BrunetonTexelOf(int64_t item, int width, int height, int* x
 // The lookup `lut` with no tables: the mappings only (a stage that needs no
 // table of the lut then copies none to the device).
 inline BrunetonLut BrunetonMappingsOnly(const BrunetonLut& lut) {
-    BrunetonLut m;
-    m.atm = lut.atm;
-    m.cfg = lut.cfg;
-    return m;
+    return BrunetonLut(lut.atm, lut.cfg);
 }
 
 // ---- transmittance (seed 004 ComputeTransmittanceToTopAtmosphereBoundaryTexture) ----
@@ -440,94 +437,30 @@ struct BrunetonAddStage {
 ATMOS_DEVICE_STAGE(BrunetonAddStage)
 
 // ---- multiple scattering of order n (seed 004 ComputeMultipleScattering(Texture)) ----
-// The 4D lookup of BrunetonLut::Lookup4D specialised for a 3-channel table
-// (same texel-centre filtering and clamping, TableView::Split), with the mu_s
-// mapping's constants hoisted: the inner loop of the multiple scattering step.
+// The density J_n's 4D lookup: the renderer's (BrunetonLut::CombinedScattering:
+// BrunetonSplitRows, BrunetonSplitColumns, BrunetonSample4D and BrunetonUMuS),
+// in its two parts so that a row of texels shares the (mu, r) rows.
 struct BrunetonFastLookup {
     const float* data;
     int width, height, depth, nu_size;
-    int mu_s_size;
-    double bottom, top, d_min, d_range, big_a;
-    double inv_d_range, inv_big_a, half_texel, texel_scale;
+    BrunetonConstants k;
     ATMOS_HD BrunetonFastLookup(const BrunetonLut& lut, const TableView& t)
         : data(t.data),
           width(t.width),
           height(t.height),
           depth(t.depth),
           nu_size(lut.cfg.scattering_nu),
-          mu_s_size(lut.cfg.scattering_mu_s) {
-        bottom = lut.atm.bottom_radius;
-        top = lut.atm.top_radius;
-        d_min = top - bottom;
-        d_range = lut.HorizonH() - d_min;
-        const double big_d = DistanceToTopAtmosphereBoundary(bottom, lut.atm.mu_s_min, top);
-        big_a = (big_d - d_min) / d_range;
-        inv_d_range = 1.0 / d_range;
-        inv_big_a = 1.0 / big_a;
-        half_texel = 0.5 / mu_s_size;
-        texel_scale = 1.0 - 1.0 / mu_s_size;
-    }
-    // TableView::Split along x for the coordinate (tex_x + u_mu_s) / NU, i.e.
-    // texel position (tex_x + u_mu_s) * MU_S - 0.5, clamped to the edges.
-    ATMOS_HD void SplitX(double tex_x_plus_u, int* i0, float* f) const {
-        double x = tex_x_plus_u * mu_s_size - 0.5;
-        if (x < 0.0) x = 0.0;
-        if (x > width - 1) x = width - 1;
-        int i = static_cast<int>(x);
-        if (i > width - 2) i = width - 2;
-        *i0 = i;
-        *f = static_cast<float>(x - i);
-    }
-    // Seed 004's u_mu_s (BrunetonLut::ScatteringUMuS); divisions by constants
-    // hoisted (the CPU's inner loop is division bound).
-    ATMOS_HD double UMuS(double mu_s) const {
-        const double d = DistanceToTopAtmosphereBoundary(bottom, mu_s, top);
-        const double a = (d - d_min) * inv_d_range;
-        return half_texel + Max(1.0 - a * inv_big_a, 0.0) / (1.0 + a) * texel_scale;
-    }
-    // The (mu, r) part of a lookup: four rows of texels and their weights.
-    struct Rows {
-        const float* row[4];
-        float w[4];
-    };
+          k(lut.k) {}
+    ATMOS_HD double UMuS(double mu_s) const { return BrunetonUMuS(k, mu_s); }
+    using Rows = Bruneton4DRows;
     ATMOS_HD void MakeRows(double u_mu, double u_r, Rows* out) const {
-        int y0, z0;
-        float fy, fz;
-        TableView::Split(u_mu, height, &y0, &fy);
-        TableView::Split(u_r, depth, &z0, &fz);
-        const int y1 = Min(y0 + 1, height - 1), z1 = Min(z0 + 1, depth - 1);
-        const int ys[2] = {y0, y1}, zs[2] = {z0, z1};
-        const float wy[2] = {1.0f - fy, fy}, wz[2] = {1.0f - fz, fz};
-        for (int k = 0; k < 2; ++k) {
-            for (int j = 0; j < 2; ++j) {
-                out->row[k * 2 + j] =
-                    data + (static_cast<size_t>(zs[k]) * height + ys[j]) * width * 3;
-                out->w[k * 2 + j] = wz[k] * wy[j];
-            }
-        }
+        *out = BrunetonSplitRows(width, height, depth, u_mu, u_r);
     }
-    // The (nu, mu_s) part, with tex_x = floor(u_nu (NU - 1)) and lerp its
-    // fraction (BrunetonLut::Lookup4D).
     ATMOS_HD Rgb SampleRows(const Rows& rows, double tex_x, float lerp, double u_mu_s) const {
-        int xa, xb;
-        float fxa, fxb;
-        SplitX(tex_x + u_mu_s, &xa, &fxa);
-        SplitX(tex_x + 1.0 + u_mu_s, &xb, &fxb);
-        const int x1a = Min(xa + 1, width - 1), x1b = Min(xb + 1, width - 1);
-        const int xs[4] = {xa, x1a, xb, x1b};
-        const float wx[4] = {(1.0f - fxa) * (1.0f - lerp), fxa * (1.0f - lerp), (1.0f - fxb) * lerp,
-                             fxb * lerp};
-        float acc[3] = {0.0f, 0.0f, 0.0f};
-        for (int k = 0; k < 4; ++k) {
-            for (int i = 0; i < 4; ++i) {
-                const float w = rows.w[k] * wx[i];
-                const float* p = rows.row[k] + static_cast<size_t>(xs[i]) * 3;
-                acc[0] += w * p[0];
-                acc[1] += w * p[1];
-                acc[2] += w * p[2];
-            }
-        }
-        return Rgb(acc[0], acc[1], acc[2]);
+        float o[3];
+        BrunetonSample4D<3>(data, rows, BrunetonSplitColumns(width, nu_size, tex_x, lerp, u_mu_s),
+                            o);
+        return Rgb(o[0], o[1], o[2]);
     }
 };
 
@@ -555,12 +488,6 @@ ATMOS_HD inline BrunetonMultipleSample BrunetonMultipleScatteringSample(
     s.t = lut.Transmittance(r, mu, d, ground) *
           static_cast<float>(BrunetonQuadratureWeight(lut.cfg.scattering_rule, i, n) * dx);
     return s;
-}
-// The nu coordinate of the 4D lookup (BrunetonLut::Lookup4D): floor and fraction.
-ATMOS_HD inline void BrunetonNuCoordinate(double nu, int nu_size, double* tex_x, float* lerp) {
-    const double tex_coord_x = (nu + 1.0) / 2.0 * (nu_size - 1);
-    *tex_x = floor(tex_coord_x);
-    *lerp = static_cast<float>(tex_coord_x - *tex_x);
 }
 // The (mu_s, nu) part of sample s: the mu_s coordinate at the sample (the
 // CPU's rows compute it for a whole row first, a loop that vectorises)...

@@ -253,7 +253,7 @@ struct HillaireEvaluator {
     ATMOS_HD Vec3d Transmittance(double r, double mu) const {
         double u, v;
         HillaireTransmittanceUv(atm, r, mu, &u, &v);
-        return Vec3d(transmittance.SampleBilinear(u, v).rgb());
+        return Vec3d(SampleBilinearRgb(transmittance, u, v));
     }
 
     // Transmittance of a segment of length d from (r, mu) that ends on the
@@ -279,7 +279,7 @@ struct HillaireEvaluator {
         if (!use_multiple_scattering) return Vec3d(0.0);
         double u, v;
         HillaireMsUv(atm, r, mu_s, &u, &v);
-        return Vec3d(multiple_scattering.SampleBilinear(u, v).rgb());
+        return Vec3d(SampleBilinearRgb(multiple_scattering, u, v));
     }
 
     // Integrates the in-scattered radiance over [ta, tb] of origin + t dir in
@@ -342,7 +342,7 @@ struct HillaireEvaluator {
         const double cos_az = lh > 1e-12 ? ClampCosine(Dot(dir_h, sun_h) / lh) : 1.0;
         double u, v;
         HillaireSkyViewUv(r, atm.bottom_radius, mu_v, cos_az, &u, &v);
-        return Vec3d(sky_view.SampleBilinear(u, v).rgb());
+        return Vec3d(SampleBilinearRgb(sky_view, u, v));
     }
 
     // Aerial perspective to distance d along dir; false when dir is outside the
@@ -360,8 +360,16 @@ struct HillaireEvaluator {
         const double d_first = HillaireApSliceDistance(0, ap_metres_per_slice);
         const double dd = Max(d, d_first);
         const double w = Sqrt(dd / (kHillaireApSize * ap_metres_per_slice));
-        Vec3d s(ap_scatter.SampleTrilinear(u, v, w).rgb());
-        Vec3d t(ap_transmittance.SampleTrilinear(u, v, w).rgb());
+        // One split for both volumes (same size, 3 channels; fixed layout).
+        const TexelSpan sx = SplitSpan(u, ap_scatter.width), sy = SplitSpan(v, ap_scatter.height);
+        const TexelSpan sz = SplitSpan(w, ap_scatter.depth);
+        float fs[3], ft[3];
+        SampleTrilinearFixed<3>(ap_scatter.data, ap_scatter.width, ap_scatter.height, sx, sy, sz,
+                                fs);
+        SampleTrilinearFixed<3>(ap_transmittance.data, ap_scatter.width, ap_scatter.height, sx, sy,
+                                sz, ft);
+        Vec3d s(Rgb(fs[0], fs[1], fs[2]));
+        Vec3d t(Rgb(ft[0], ft[1], ft[2]));
         if (d < d_first) {
             // Linear fade from the camera (L = 0, T = 1) to the first slice centre.
             const double f = d / d_first;

@@ -73,13 +73,52 @@ double PreethamZenithY(double T, double theta_s);
 // Extraterrestrial solar illuminance (lm/m^2) the radiance scale divides by.
 constexpr double kPreethamSolarIlluminance = 128e3;
 
+// The terms of one view that depend on the sun and the camera's up only.
+struct PreethamSunTerms {
+    Vec3d s;                                 // the sun, raised to the horizon when below it
+    double theta_s = 0.0;                    // its zenith angle
+    double Yz = 0.0, xz = 0.0, yz = 0.0;     // zenith luminance and chromaticity
+    double fY0 = 1.0, fx0 = 1.0, fy0 = 1.0;  // F(0, theta_s) of Y, x, y
+};
+
 struct PreethamEvaluator {
     double bottom = 6360e3, top = 6460e3;
     double turbidity = 2.5;
     PerezCoefficients kY{}, kx{}, ky{};
+    // The sun terms of the view set by PrepareView (render/render.h calls it
+    // once per frame): a ray from that camera toward that sun reuses them; any
+    // other (a sample query) computes its own, by the same code.
+    bool has_view = false;
+    Vec3d view_camera, view_sun;
+    PreethamSunTerms view;
 
-    // Perez normalisation and zenith values depend on the sun only; they are
-    // evaluated per ray (cheap) so the evaluator needs no per-view state.
+    ATMOS_HD PreethamSunTerms SunTerms(const Vec3d& up, const Vec3d& sun) const {
+        PreethamSunTerms t;
+        // Sun raised to the horizon when below it.
+        double cos_s = Dot(sun, up);
+        t.s = sun;
+        if (cos_s < 0.0) {
+            const Vec3d horizontal = sun - up * cos_s;
+            const double len = Length(horizontal);
+            t.s = len > 1e-9 ? horizontal / len : Normalize(Cross(up, Vec3d(1.0, 0.0, 0.0)));
+            cos_s = 0.0;
+        }
+        t.theta_s = acos(Clamp(cos_s, -1.0, 1.0));
+        t.Yz = ZenithLuminance(t.theta_s);
+        t.xz = ZenithChromaticity(t.theta_s, true);
+        t.yz = ZenithChromaticity(t.theta_s, false);
+        t.fY0 = PerezF(kY, 1.0, t.theta_s);
+        t.fx0 = PerezF(kx, 1.0, t.theta_s);
+        t.fy0 = PerezF(ky, 1.0, t.theta_s);
+        return t;
+    }
+    ATMOS_HD void PrepareView(const Vec3d& camera, const Vec3d& sun) {
+        view = SunTerms(Normalize(camera), sun);
+        view_camera = camera;
+        view_sun = sun;
+        has_view = true;
+    }
+
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                 bool) const {
         RayResult out;
@@ -89,24 +128,15 @@ struct PreethamEvaluator {
         if (seg.hits_ground) out.transmittance = Rgb(0.0f);
         if (!seg.inside || seg.hits_ground) return out;
         const Vec3d up = Normalize(camera);
-        // Sun raised to the horizon when below it.
-        double cos_s = Dot(sun, up);
-        Vec3d s = sun;
-        if (cos_s < 0.0) {
-            const Vec3d horizontal = sun - up * cos_s;
-            const double len = Length(horizontal);
-            s = len > 1e-9 ? horizontal / len : Normalize(Cross(up, Vec3d(1.0, 0.0, 0.0)));
-            cos_s = 0.0;
-        }
-        const double theta_s = acos(Clamp(cos_s, -1.0, 1.0));
+        const bool same_view = has_view && camera.x == view_camera.x && camera.y == view_camera.y &&
+                               camera.z == view_camera.z && sun.x == view_sun.x &&
+                               sun.y == view_sun.y && sun.z == view_sun.z;
+        const PreethamSunTerms st = same_view ? view : SunTerms(up, sun);
         const double cos_theta = Max(Dot(dir, up), 0.001);
-        const double gamma = acos(Clamp(Dot(dir, s), -1.0, 1.0));
-        const double Yz = ZenithLuminance(theta_s);
-        const double xz = ZenithChromaticity(theta_s, true);
-        const double yz = ZenithChromaticity(theta_s, false);
-        const double Y = Yz * PerezF(kY, cos_theta, gamma) / PerezF(kY, 1.0, theta_s);
-        const double x = xz * PerezF(kx, cos_theta, gamma) / PerezF(kx, 1.0, theta_s);
-        const double y = yz * PerezF(ky, cos_theta, gamma) / PerezF(ky, 1.0, theta_s);
+        const double gamma = acos(Clamp(Dot(dir, st.s), -1.0, 1.0));
+        const double Y = st.Yz * PerezF(kY, cos_theta, gamma) / st.fY0;
+        const double x = st.xz * PerezF(kx, cos_theta, gamma) / st.fx0;
+        const double y = st.yz * PerezF(ky, cos_theta, gamma) / st.fy0;
         // xyY -> XYZ (radiance units: kcd/m^2 -> per unit solar irradiance).
         const double L = Max(Y, 0.0) * 1000.0 / kPreethamSolarIlluminance;
         const double yy = Max(y, 1e-6);

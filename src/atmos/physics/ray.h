@@ -32,6 +32,7 @@
 
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 
 #include "atmos/math.h"
 #include "physics/geometry.h"
@@ -86,6 +87,22 @@ ATMOS_HD inline RayResult EvaluateRay(const Evaluator& evaluator, const Vec3d& c
         (void)key;
         return evaluator.Evaluate(camera, dir, sun, want_ground);
     }
+}
+
+// Evaluators with terms that depend on the view only (camera position and
+// sun: e.g. a sky model's sun terms) declare
+//   void PrepareView(const Vec3d& camera, const Vec3d& sun);
+// the render loop calls it on its copy once per frame; Evaluate must still give
+// the same answer for any other camera or sun (sample queries).
+template <typename E, typename = void>
+struct HasPrepareView : std::false_type {};
+template <typename E>
+struct HasPrepareView<E, std::void_t<decltype(std::declval<E&>().PrepareView(
+                             std::declval<const Vec3d&>(), std::declval<const Vec3d&>()))>>
+    : std::true_type {};
+template <typename Evaluator>
+inline void PrepareViewIfAny(Evaluator* evaluator, const Vec3d& camera, const Vec3d& sun) {
+    if constexpr (HasPrepareView<Evaluator>::value) evaluator->PrepareView(camera, sun);
 }
 
 // True for evaluators that declare kHostOnly (no device kernels).

@@ -160,6 +160,7 @@ void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView 
         FailNoDeviceKernels(typeid(Evaluator).name());
     }
     RenderStage<Evaluator> stage{evaluator, setup, {}};
+    PrepareViewIfAny(&stage.evaluator, setup.camera.position, setup.sun_direction);
     stage.out.data = out.data;
     stage.out.width = out.width;
     stage.out.height = out.height;
