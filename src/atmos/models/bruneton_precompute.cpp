@@ -91,9 +91,13 @@ void ComputeBrunetonSingleScatteringRows(const BrunetonLut& lut, Table* rayleigh
         const int n = c.scattering_samples;
         const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
         std::vector<BrunetonSingleSample> samples(static_cast<size_t>(n) + 1);
+        const bool thick = RayHasThickSteps(lut.atm, r, mu, dx, n);
+        ThickRayWeights weights(r, mu, dx, n);
         for (int i = 0; i <= n; ++i) {
+            Vec3d w;
+            if (thick) w = weights.Next(lut.atm, i);
             samples[static_cast<size_t>(i)] =
-                BrunetonSingleScatteringSample(lut, r, mu, ground, dx, i, n);
+                BrunetonSingleScatteringSample(lut, r, mu, ground, dx, i, n, thick ? &w : nullptr);
         }
         const Rgb beta_r = Rgb(lut.atm.rayleigh_scattering * dx);
         const Rgb beta_m = Rgb(lut.atm.mie_scattering * dx);
@@ -130,9 +134,13 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
         const int n = c.scattering_samples;
         const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
         std::vector<BrunetonMultipleSample> samples(static_cast<size_t>(n) + 1);
+        const bool thick = RayHasThickSteps(lut.atm, r, mu, dx, n);
+        ThickRayWeights weights(r, mu, dx, n);
         for (int i = 0; i <= n; ++i) {
-            samples[static_cast<size_t>(i)] =
-                BrunetonMultipleScatteringSample(lut, fast, r, mu, ground, dx, i, n);
+            Vec3d w;
+            if (thick) w = weights.Next(lut.atm, i);
+            samples[static_cast<size_t>(i)] = BrunetonMultipleScatteringSample(
+                lut, fast, r, mu, ground, dx, i, n, thick ? &w : nullptr);
         }
         // Samples outer, texels inner: the four table rows of one sample stay in
         // the cache while the row's texels read them.
