@@ -18,6 +18,7 @@
 #include "atmos/model.h"
 #include "atmos/number.h"
 #include "atmos/view.h"
+#include "base/library_progress.h"
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "cli_monte_carlo.h"
@@ -94,6 +95,7 @@ int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags) {
     const MonteCarloSettings monte_carlo = flags.Settings(model->Info());
     const std::vector<SampleQuery> queries = ReadQueries(std::cin);
     PrepareModel(common, atmosphere, model.get());
+    const LibraryProgressScope progress(!common.quiet);  // long batches show a bar
     const std::vector<SampleAnswer> answers = model->Info().capabilities.stochastic
                                                   ? SampleMonteCarlo(*model, queries, monte_carlo)
                                                   : model->Sample(queries);
