@@ -10,4 +10,7 @@ if [ "${1:-}" = "--sanitize" ]; then build_dir=build-asan; fi
 scripts/setup.sh "$@"
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+# The fuzz test's queries per model and atmosphere (tests/fuzz_test.cpp): 1e5 by
+# default; 2000 under the sanitizers, where each query costs 10-20x.
+if [ "${1:-}" = "--sanitize" ]; then export ATMOS_FUZZ_QUERIES="${ATMOS_FUZZ_QUERIES:-2000}"; fi
 ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" -LE slow

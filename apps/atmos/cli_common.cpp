@@ -2,6 +2,7 @@
 
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "base/library_progress.h"
 
 namespace atmos::cli {
 
@@ -72,6 +73,8 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphere, Model* model) {
     const auto start = std::chrono::steady_clock::now();
+    // Precomputations over a second show a progress bar (issue 18 item 9).
+    const LibraryProgressScope progress(!o.quiet);
     if (o.load.empty()) {
         model->Prepare(atmosphere);
     } else {

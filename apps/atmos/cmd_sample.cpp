@@ -16,6 +16,7 @@
 #include "atmos/model.h"
 #include "atmos/number.h"
 #include "atmos/view.h"
+#include "base/library_progress.h"
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "cli_monte_carlo.h"
@@ -216,6 +217,7 @@ int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const S
     const MonteCarloSettings monte_carlo = flags.Settings(model->Info());
     const std::vector<SampleQuery> queries = ReadQueries(io.input);
     PrepareModel(common, atmosphere, model.get());
+    const LibraryProgressScope progress(!common.quiet);  // long batches show a bar
     const std::vector<SampleAnswer> answers = model->Info().capabilities.stochastic
                                                   ? SampleMonteCarlo(*model, queries, monte_carlo)
                                                   : model->Sample(queries);

@@ -1,5 +1,7 @@
 #include "base/progress.h"
 
+#include "base/library_progress.h"
+
 #include <unistd.h>
 
 #include <cstdio>
@@ -7,9 +9,17 @@
 namespace atmos {
 
 namespace {
+std::atomic<bool> g_library_progress{false};
 constexpr double kQuietSeconds = 1.0;   // show nothing for work shorter than this
 constexpr double kRedrawSeconds = 0.1;  // at most 10 redraws a second
 }  // namespace
+
+bool LibraryProgressEnabled() { return g_library_progress.load(std::memory_order_relaxed); }
+
+LibraryProgressScope::LibraryProgressScope(bool enabled)
+    : previous_(g_library_progress.exchange(enabled)) {}
+
+LibraryProgressScope::~LibraryProgressScope() { g_library_progress.store(previous_); }
 
 Progress::Progress(std::string label, int64_t total, bool enabled)
     : label_(std::move(label)),

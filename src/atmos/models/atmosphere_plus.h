@@ -62,6 +62,7 @@
 #include "models/atmosphere_plus_mapping.h"
 #include "models/evaluator_model.h"
 #include "physics/density.h"
+#include "physics/exp_quadrature.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
 #include "physics/transmittance.h"
@@ -98,6 +99,23 @@ ATMOS_HD inline AplusValue operator*(const AplusValue& a, double s) {
     return r;
 }
 
+// The exponential-linear rule's node factors W_i / sigma_t,i on a view segment
+// whose optical depth is the trapezoid of the nodes' extinction (the seed's
+// tau_view, so the rule's transmittance is the seed's): node i's factor needs
+// the optical depth of the interval after it, i.e. node i + 1's extinction.
+struct AplusThickNodes {
+    ExpLinearNodeWeights rule;
+    ATMOS_HD Vec3d Next(const AtmosphereParameters& atm, const Vec3d& p0, const Vec3d& dir,
+                        double t0, double ds, int i, int steps, const Vec3d& ext) {
+        Vec3d dtau;
+        if (i < steps) {
+            const double alt = Length(p0 + dir * (t0 + (i + 1) * ds)) - atm.bottom_radius;
+            dtau = (ext + Extinction(atm, GetDensities(atm, alt))) * (0.5 * ds);
+        }
+        return PerExtinction(rule.Next(dtau), ext);
+    }
+};
+
 // Seed 000 sections 1.10, 2.1, 2.3: the factored single scattering I1 for an
 // observer at altitude h looking along mu with the sun at mu_s (azimuth 0),
 // trapezoidal rule with `steps` intervals along the view segment and
@@ -111,6 +129,11 @@ ATMOS_HD inline AplusValue AplusSingleScattering(const AtmosphereParameters& atm
     const AtmosphereSegment seg = ClipToAtmosphere(p0, view, atm.bottom_radius, atm.top_radius);
     if (!seg.inside) return out;
     const double ds = (seg.t_end - seg.t_start) / steps;
+    // Optically thick steps: the exponential-linear rule on the same nodes and
+    // optical depths (physics/exp_quadrature.h; the trapezoid is not energy
+    // conserving there).
+    const bool thick = RayHasThickSteps(atm, p0, view, seg.t_start, ds, steps);
+    AplusThickNodes nodes;
     Vec3d tau_view;  // P_a to the current node
     Vec3d prev_ext;
     Vec3d sum_r;
@@ -122,10 +145,18 @@ ATMOS_HD inline AplusValue AplusSingleScattering(const AtmosphereParameters& atm
         const Vec3d ext = Extinction(atm, d);
         if (i > 0) tau_view += (prev_ext + ext) * (0.5 * ds);
         prev_ext = ext;
+        Vec3d thick_w;
+        if (thick) thick_w = nodes.Next(atm, p0, view, seg.t_start, ds, i, steps, ext);
         const double mu_sun = ClampCosine(Dot(p, sun) / r);
         if (RayIntersectsGround(r, mu_sun, atm.bottom_radius)) continue;  // P_c on the ground
         const double length = DistanceToTopAtmosphereBoundary(r, mu_sun, atm.top_radius);
         const Vec3d tau_sun = OpticalDepth(atm, p, sun, length, sun_steps);
+        if (thick) {
+            const Vec3d t = Exp(-tau_sun) * thick_w;
+            sum_r += t * d.rayleigh;
+            sum_m += Channel(t, kAplusMieChannel) * d.mie;
+            continue;
+        }
         const Vec3d t = Exp(-(tau_view + tau_sun));
         const double w = (i == 0 || i == steps) ? 0.5 * ds : ds;
         sum_r += t * (d.rayleigh * w);

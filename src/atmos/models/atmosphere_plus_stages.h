@@ -55,6 +55,9 @@ ATMOS_HD inline AplusValue AplusOrderFromGather(const TableView& gather,
     const int steps = s.transmittance_steps;
     const double ds = (seg.t_end - seg.t_start) / steps;
     const double top = atm.top_radius - atm.bottom_radius;
+    // Optically thick steps: the exponential-linear rule (AplusThickNodes).
+    const bool thick = RayHasThickSteps(atm, p0, view, seg.t_start, ds, steps);
+    AplusThickNodes nodes;
     Vec3d tau_view, prev_ext, sum_r;
     double sum_m = 0.0;
     for (int i = 0; i <= steps; ++i) {
@@ -67,6 +70,12 @@ ATMOS_HD inline AplusValue AplusOrderFromGather(const TableView& gather,
         prev_ext = ext;
         const AplusValue gp = AplusFromVec4f(AplusSample(
             gather, s.mapping, hp, ClampCosine(Dot(p, view) / r), ClampCosine(Dot(p, sun) / r)));
+        if (thick) {
+            const Vec3d t = nodes.Next(atm, p0, view, seg.t_start, ds, i, steps, ext);
+            sum_r += gp.rayleigh * t * d.rayleigh;
+            sum_m += gp.mie * Channel(t, kAplusMieChannel) * d.mie;
+            continue;
+        }
         const Vec3d t = Exp(-tau_view);
         const double w = (i == 0 || i == steps) ? 0.5 * ds : ds;
         sum_r += gp.rayleigh * t * (d.rayleigh * w);

@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "atmos/error.h"
+#include "base/library_progress.h"
 #include "base/parallel.h"
+#include "base/progress.h"
 #include "models/bruneton.h"
 #include "models/bruneton_stages.h"
 #include "models/order_check.h"
@@ -89,9 +91,13 @@ void ComputeBrunetonSingleScatteringRows(const BrunetonLut& lut, Table* rayleigh
         const int n = c.scattering_samples;
         const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
         std::vector<BrunetonSingleSample> samples(static_cast<size_t>(n) + 1);
+        const bool thick = RayHasThickSteps(lut.atm, r, mu, dx, n);
+        ThickRayWeights weights(r, mu, dx, n);
         for (int i = 0; i <= n; ++i) {
+            Vec3d w;
+            if (thick) w = weights.Next(lut.atm, i);
             samples[static_cast<size_t>(i)] =
-                BrunetonSingleScatteringSample(lut, r, mu, ground, dx, i, n);
+                BrunetonSingleScatteringSample(lut, r, mu, ground, dx, i, n, thick ? &w : nullptr);
         }
         const Rgb beta_r = Rgb(lut.atm.rayleigh_scattering * dx);
         const Rgb beta_m = Rgb(lut.atm.mie_scattering * dx);
@@ -128,9 +134,13 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
         const int n = c.scattering_samples;
         const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
         std::vector<BrunetonMultipleSample> samples(static_cast<size_t>(n) + 1);
+        const bool thick = RayHasThickSteps(lut.atm, r, mu, dx, n);
+        ThickRayWeights weights(r, mu, dx, n);
         for (int i = 0; i <= n; ++i) {
-            samples[static_cast<size_t>(i)] =
-                BrunetonMultipleScatteringSample(lut, fast, r, mu, ground, dx, i, n);
+            Vec3d w;
+            if (thick) w = weights.Next(lut.atm, i);
+            samples[static_cast<size_t>(i)] = BrunetonMultipleScatteringSample(
+                lut, fast, r, mu, ground, dx, i, n, thick ? &w : nullptr);
         }
         // Samples outer, texels inner: the four table rows of one sample stay in
         // the cache while the row's texels read them.
@@ -176,6 +186,10 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
     BrunetonLut lut(atmosphere, config);
     const BrunetonLut mappings = BrunetonMappingsOnly(lut);
     const int width = config.scattering_nu * config.scattering_mu_s;
+    // A progress bar (CLI, over a second): one step for order 1, four per
+    // further order (incident radiance, density, irradiance, multiple scattering).
+    Progress progress("bruneton precompute", 1 + 4 * static_cast<int64_t>(config.orders - 1),
+                      LibraryProgressEnabled());
     // On a device backend all tables stay on the device between the stages;
     // the host gets the final tables, and the tables on_order reads, by Download.
     StageSession session;
@@ -219,6 +233,7 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
     RunStage("bruneton combine", TexelCount(delta_rayleigh), width,
              BrunetonCombineStage{delta_rayleigh.view(), delta_mie.view(), tables->scattering.out(),
                                   config.combined_mie ? TableOut() : tables->single_mie.out()});
+    progress.Add(1);
     if (on_order) {
         download(nullptr);
         on_order(1, *tables, nullptr);
@@ -253,10 +268,12 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
                  static_cast<int64_t>(kBrunetonDirections) * config.scattering_mu_s *
                      config.scattering_r,
                  kBrunetonDirections, inc);
+        progress.Add(1);
         delta_density.Resize(width, config.scattering_mu, config.scattering_r, 3);
         RunStage("bruneton scattering density", TexelCount(delta_density), width,
                  BrunetonDensityStage{mappings, incident.view(), directions.view(),
                                       delta_density.out()});
+        progress.Add(1);
 
         BrunetonIndirectIrradianceStage irr;
         irr.lut = mappings;
@@ -271,6 +288,7 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
         RunStage("bruneton indirect irradiance", TexelCount(delta_irradiance), 4, irr);
         RunStage("bruneton add irradiance", TexelCount(delta_irradiance), config.irradiance_width,
                  BrunetonAddStage{delta_irradiance.view(), tables->irradiance.out(true)});
+        progress.Add(1);
 
         if (texel_stages) {
             delta_multiple.Resize(width, config.scattering_mu, config.scattering_r, 3);
@@ -280,6 +298,7 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
         } else {
             ComputeBrunetonMultipleScatteringRows(lut, delta_density.view(), &delta_multiple);
         }
+        progress.Add(1);
         session.Download(&delta_multiple);
         sums.Add(order, TableSum(delta_multiple));
         // Accumulate, divided by the Rayleigh phase function (the renderer

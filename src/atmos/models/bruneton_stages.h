@@ -19,6 +19,7 @@
 #include <cstdint>
 
 #include "models/bruneton.h"
+#include "physics/exp_quadrature.h"
 #include "physics/transmittance.h"
 #include "render/stages.h"
 
@@ -95,7 +96,10 @@ ATMOS_DEVICE_STAGE(BrunetonDirectIrradianceStage)
 // i.e. what one (r, mu) row of the table shares: the distance d_i, the radius
 // r_i, and the transmittance from the camera times the Rayleigh and Mie
 // densities and the trapezoid weight (seed 004 ComputeSingleScatteringIntegrand
-// and the sum of ComputeSingleScattering).
+// and the sum of ComputeSingleScattering). On a ray with optically thick steps
+// (RayHasThickSteps) `thick` is the node's ThickRayWeights factor W_i /
+// sigma_t,i instead (physics/exp_quadrature.h: the seed's rule is not energy
+// conserving there).
 struct BrunetonSingleSample {
     double d, r;
     Rgb t_rayleigh, t_mie;
@@ -103,12 +107,19 @@ struct BrunetonSingleSample {
 ATMOS_HD inline BrunetonSingleSample BrunetonSingleScatteringSample(const BrunetonLut& lut,
                                                                     double r, double mu,
                                                                     bool ground, double dx, int i,
-                                                                    int n) {
+                                                                    int n,
+                                                                    const Vec3d* thick = nullptr) {
     const AtmosphereParameters& atm = lut.atm;
     BrunetonSingleSample s;
     const double d = i * dx;
     s.d = d;
     s.r = lut.ClampRadius(Sqrt(d * d + 2.0 * r * mu * d + r * r));
+    if (thick) {  // W_i / sigma_t,i / dx: the caller multiplies by beta dx
+        const double alt = s.r - atm.bottom_radius;
+        s.t_rayleigh = Rgb(*thick * (GetProfileDensity(atm.rayleigh_density, alt) / dx));
+        s.t_mie = Rgb(*thick * (GetProfileDensity(atm.mie_density, alt) / dx));
+        return s;
+    }
     const Rgb t = lut.Transmittance(r, mu, d, ground);
     const double alt = s.r - atm.bottom_radius;
     const float w = static_cast<float>(BrunetonQuadratureWeight(lut.cfg.scattering_rule, i, n));
@@ -146,10 +157,14 @@ struct BrunetonSingleScatteringStage {
         lut.RMuMuSNuFromTexel(x, y, z, &r, &mu, &mu_s, &nu, &ground);
         const int n = lut.cfg.scattering_samples;
         const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
+        const bool thick = RayHasThickSteps(lut.atm, r, mu, dx, n);
+        ThickRayWeights weights(r, mu, dx, n);
         Rgb sum_r, sum_m;
         for (int i = 0; i <= n; ++i) {
+            Vec3d w;
+            if (thick) w = weights.Next(lut.atm, i);
             const BrunetonSingleSample s =
-                BrunetonSingleScatteringSample(lut, r, mu, ground, dx, i, n);
+                BrunetonSingleScatteringSample(lut, r, mu, ground, dx, i, n, thick ? &w : nullptr);
             BrunetonSingleScatteringAdd(lut, s, r, mu_s, nu, &sum_r, &sum_m);
         }
         rayleigh.Set(x, y, z, BrunetonVec4(sum_r * Rgb(lut.atm.rayleigh_scattering * dx)));
@@ -467,7 +482,8 @@ struct BrunetonFastLookup {
 // Sample i of n along the view ray (r, mu) of the multiple scattering integral
 // (seed 004 ComputeMultipleScattering): what one (r, mu) row shares: distance,
 // radius, the (mu, r) rows of the density lookup, and the transmittance from
-// the camera times the trapezoid weight and dx.
+// the camera times the trapezoid weight and dx (on a ray with optically thick
+// steps: `thick`, the node's W_i / sigma_t,i, as for single scattering).
 struct BrunetonMultipleSample {
     double d, r, inv_r;
     BrunetonFastLookup::Rows rows;
@@ -475,7 +491,7 @@ struct BrunetonMultipleSample {
 };
 ATMOS_HD inline BrunetonMultipleSample BrunetonMultipleScatteringSample(
     const BrunetonLut& lut, const BrunetonFastLookup& fast, double r, double mu, bool ground,
-    double dx, int i, int n) {
+    double dx, int i, int n, const Vec3d* thick = nullptr) {
     BrunetonMultipleSample s;
     const double d = i * dx;
     s.d = d;
@@ -485,6 +501,10 @@ ATMOS_HD inline BrunetonMultipleSample BrunetonMultipleScatteringSample(
     double u_mu, u_r;
     lut.ScatteringUMuR(s.r, mu_i, ground, &u_mu, &u_r);
     fast.MakeRows(u_mu, u_r, &s.rows);
+    if (thick) {
+        s.t = Rgb(*thick);
+        return s;
+    }
     s.t = lut.Transmittance(r, mu, d, ground) *
           static_cast<float>(BrunetonQuadratureWeight(lut.cfg.scattering_rule, i, n) * dx);
     return s;
@@ -527,10 +547,14 @@ struct BrunetonMultipleScatteringStage {
         double tex_x;
         float lerp;
         BrunetonNuCoordinate(nu, lut.cfg.scattering_nu, &tex_x, &lerp);
+        const bool thick = RayHasThickSteps(lut.atm, r, mu, dx, n);
+        ThickRayWeights weights(r, mu, dx, n);
         Rgb sum;
         for (int i = 0; i <= n; ++i) {
-            const BrunetonMultipleSample s =
-                BrunetonMultipleScatteringSample(lut, fast, r, mu, ground, dx, i, n);
+            Vec3d w;
+            if (thick) w = weights.Next(lut.atm, i);
+            const BrunetonMultipleSample s = BrunetonMultipleScatteringSample(
+                lut, fast, r, mu, ground, dx, i, n, thick ? &w : nullptr);
             const double u_mu_s = BrunetonMultipleScatteringUMuS(fast, s, r, mu_s, nu);
             sum += BrunetonMultipleScatteringTerm(fast, s, tex_x, lerp, u_mu_s);
         }

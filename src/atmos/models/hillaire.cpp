@@ -17,6 +17,7 @@
 #include "io/table_io.h"
 #include "models/hillaire_stages.h"
 #include "models/option_json.h"
+#include "models/order_check.h"
 #include "render/stages.h"
 
 namespace atmos {
@@ -99,10 +100,14 @@ void HillaireModel::Prepare(const AtmosphereParameters& atmosphere) {
     ResidentScope scope(&resident_);
     StageSession session;
     BuildTransmittance();
-    BuildMultipleScattering();
+    Table transfer;
+    BuildMultipleScattering(&transfer);
     session.Download(&transmittance_);
     session.Download(&multiple_scattering_);
+    session.Download(&transfer);
     scope.Keep(evaluator_);
+    // The series 1 / (1 - f_ms) past its limit (models/order_check.h).
+    WarnIfSeriesPastLimit("hillaire", TableMax(transfer));
 }
 
 // The evaluator the precomputation stages read: the model's tables, no frame
@@ -129,13 +134,15 @@ void HillaireModel::BuildTransmittance() {
 
 // Multiple-scattering table (paper section 5.5.2, Eq. 5-10): see hillaire.h
 // (HillaireMultipleScatteringStage).
-void HillaireModel::BuildMultipleScattering() {
+void HillaireModel::BuildMultipleScattering(Table* transfer) {
     multiple_scattering_.Resize(kHillaireMsSize, kHillaireMsSize, 1, 3);
+    if (transfer) transfer->Resize(kHillaireMsSize, kHillaireMsSize, 1, 3);
     HillaireMultipleScatteringStage stage;
     stage.e = StageEvaluator();
     stage.e.use_multiple_scattering = false;
     stage.e.multiple_scattering = TableView{};  // not read (the table being built)
     stage.out = multiple_scattering_.out();
+    if (transfer) stage.transfer = transfer->out();
     RunStage("hillaire/multiple-scattering", int64_t{kHillaireMsSize} * kHillaireMsSize, 4, stage);
     Attach();
 }

@@ -490,7 +490,8 @@ class HillaireModel : public Model {
     // table for the current atmosphere, then the multiple-scattering table
     // from it.
     void BuildTransmittance();
-    void BuildMultipleScattering();
+    // transfer (optional): receives f_ms per texel (HillaireMultipleScatteringStage).
+    void BuildMultipleScattering(Table* transfer = nullptr);
 
   private:
     void Attach();

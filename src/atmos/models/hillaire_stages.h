@@ -65,11 +65,13 @@ ATMOS_DEVICE_STAGE(HillaireTransmittanceStage)
 struct HillaireMultipleScatteringStage {
     HillaireEvaluator e;
     TableOut out;
+    TableOut transfer;  // optional (no data: not written): f_ms per texel, RGB
 
     template <typename V>
     void VisitTables(V& v) {
         e.VisitTables(v);
         v(out);
+        v(transfer);
     }
     ATMOS_HD void operator()(int64_t index) const {
         const AtmosphereParameters& atm = e.atm;
@@ -124,6 +126,7 @@ struct HillaireMultipleScatteringStage {
         Vec3d psi;
         for (int c = 0; c < 3; ++c) psi[c] = l_2nd[c] / Max(1.0 - f_ms[c], 1e-6);
         out.Set(i, j, 0, HillaireTexel(psi));
+        if (transfer.data) transfer.Set(i, j, 0, HillaireTexel(f_ms));
     }
 };
 ATMOS_DEVICE_STAGE(HillaireMultipleScatteringStage)

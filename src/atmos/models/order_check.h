@@ -13,6 +13,7 @@
 // on stderr (and the model's `atmos list` validity says where this happens).
 #pragma once
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -29,6 +30,39 @@ inline double TableSum(const Table& table) {
         static_cast<size_t>(v.width) * v.height * v.depth * static_cast<size_t>(v.channels);
     for (size_t i = 0; i < n; ++i) sum += static_cast<double>(v.data[i]);
     return sum;
+}
+
+// Largest value of a table (host memory; 0 for an empty one).
+inline double TableMax(const Table& table) {
+    const TableView& v = table.view();
+    double m = 0.0;
+    const size_t n =
+        static_cast<size_t>(v.width) * v.height * v.depth * static_cast<size_t>(v.channels);
+    for (size_t i = 0; i < n; ++i) m = std::max(m, static_cast<double>(v.data[i]));
+    return m;
+}
+
+// Hillaire's multiple scattering (hillaire.h, paper Eq. 5-10) sums every order
+// beyond the second as a geometric series L_2nd (f_ms + f_ms^2 + ...): it
+// assumes each order is re-scattered with the transfer f_ms of the second
+// (isotropic, and the neighbourhood lit as the point). Where f_ms exceeds
+// kSeriesTransferLimit, the orders the series assumes (f_ms / (1 - f_ms) times
+// the second) carry more than the second order it computes: the result rests
+// on the assumption, which over-brightens optically thick media (the path
+// tracer's light decays with depth, the series' does not).
+constexpr double kSeriesTransferLimit = 0.5;
+
+// Prints one warning line on stderr when the largest transfer f_ms exceeds
+// kSeriesTransferLimit; returns whether it did.
+inline bool WarnIfSeriesPastLimit(const char* model, double max_transfer) {
+    if (!(max_transfer > kSeriesTransferLimit)) return false;
+    std::fprintf(stderr,
+                 "atmos: warning: model %s: multiple-scattering transfer f_ms reaches %.3g (above "
+                 "%.2g: the orders its series 1 / (1 - f_ms) assumes outweigh the second order it "
+                 "computes): optically thick atmosphere, its radiance is not valid here (`atmos "
+                 "list %s`, validity)\n",
+                 model, max_transfer, kSeriesTransferLimit, model);
+    return true;
 }
 
 class ScatteringOrders {

@@ -24,6 +24,7 @@
 #include "atmos/math.h"
 #include "atmos/model.h"
 #include "atmos/view.h"
+#include "base/library_progress.h"
 #include "base/parallel.h"
 #include "base/progress.h"
 #include "physics/geometry.h"
@@ -194,7 +195,10 @@ std::vector<SampleAnswer> SampleAll(const Evaluator& evaluator, double bottom_ra
     stage.answers.data = reinterpret_cast<float*>(answers.data());
     stage.answers.width = static_cast<int>(answers.size());
     stage.answers.channels = kAnswerFloats;
-    RunStage("sample", static_cast<int64_t>(queries.size()), 64, stage);
+    // A progress bar for long batches (the CLI's `sample`, over a second;
+    // base/library_progress.h).
+    Progress progress("sample", static_cast<int64_t>(queries.size()), LibraryProgressEnabled());
+    RunStage("sample", static_cast<int64_t>(queries.size()), 64, stage, &progress);
     GuardOutput(reinterpret_cast<float*>(answers.data()), answers.size() * kAnswerFloats);
     return answers;
 }
