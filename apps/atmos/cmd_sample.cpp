@@ -17,12 +17,14 @@
 #include "atmos/image.h"
 #include "atmos/model.h"
 #include "atmos/number.h"
+#include "atmos/spectral.h"
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "cli_monte_carlo.h"
 #include "harness/gallery.h"
 #include "render/progressive.h"
+#include "sample_spectral.h"
 
 namespace fs = std::filesystem;
 
@@ -86,9 +88,15 @@ std::vector<SampleQuery> ReadQueries(std::istream& in) {
     return queries;
 }
 
-int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags) {
+int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags,
+              const SpectralFlags& spectral) {
     ThreadLimit limit(common.threads);
     const BackendScope backend(ParseBackend(common.backend));
+    if (!spectral.wavelengths.empty()) {
+        ParseWavelengths(spectral.wavelengths);  // fail before reading stdin
+        const MonteCarloSettings mc = flags.Settings(CreateModel(GivenModel(common))->Info());
+        return SampleSpectralCsv(common, mc, spectral.wavelengths, ReadQueries(std::cin));
+    }
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(GivenModel(common));
     const MonteCarloSettings monte_carlo = flags.Settings(model->Info());
@@ -115,13 +123,15 @@ int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags) {
 Command AddSampleCommand(CLI::App* root) {
     auto common = std::make_shared<CommonOptions>();
     auto flags = std::make_shared<MonteCarloFlags>();
+    auto spectral = std::make_shared<SpectralFlags>();
     Command c;
     c.app = root->add_subcommand(
         "sample", "evaluate a model at queries read as CSV from stdin, answers to stdout");
     AddCommonOptions(c.app, common.get());
     AddBackendOption(c.app, &common->backend);
     AddMonteCarloFlags(c.app, flags.get());
-    c.run = [common, flags] { return CmdSample(*common, *flags); };
+    AddSpectralFlags(c.app, spectral.get(), false);
+    c.run = [common, flags, spectral] { return CmdSample(*common, *flags, *spectral); };
     return c;
 }
 
