@@ -514,7 +514,7 @@ TEST(Cli, RenderWavelengthsWritesTheSpectralExr) {
 // subset of the measurements). naive's errors against the measured sky; the
 // figures are the regression (relative RMSE over the mean measured radiance).
 TEST(Cli, ValidateKiderOnTwoCaptures) {
-    const fs::path data = fs::path(__FILE__).parent_path() / "data" / "kider-2013";
+    const fs::path data = fs::path(ATMOS_SOURCE_DIR) / "tests" / "data" / "kider-2013";
     const Result r = RunAtmos("validate kider-2013 -q --models naive --data " + data.string());
     ASSERT_EQ(r.status, 0) << r.err;
     std::istringstream lines(r.out);
@@ -535,7 +535,10 @@ TEST(Cli, ValidateKiderOnTwoCaptures) {
     while (std::getline(fields, item, ',')) f.push_back(item);
     ASSERT_EQ(f.size(), 9u);
     EXPECT_EQ(f[8], "6400");  // 2 captures x 80 directions x 40 bins
-    EXPECT_NEAR(std::stod(f[4]), -1.0, 0.5) << overall;
+    // Measured with this commit: 48.33 % (naive, single scattering, is darker than
+    // the sky: 33.56e-3 modelled against 52.71e-3 measured on average).
+    EXPECT_NEAR(std::stod(f[4]), 48.33, 0.5) << overall;
+    EXPECT_LT(std::stod(f[6]), std::stod(f[7])) << overall;
     ExpectError("validate kider-2013 --data /nonexistent", "kider_ref.csv");
     ExpectError("validate other", "unknown data set");
 }

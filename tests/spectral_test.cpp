@@ -192,7 +192,12 @@ TEST(Spectral, LawsMatchTheirSources) {
     SpectralDataTable("penndorf-1957", 0, &nm, &table);
     ASSERT_EQ(nm.size(), 48u);
     for (size_t i = 0; i < nm.size(); ++i) {
-        EXPECT_NEAR(PenndorfRayleigh(nm[i]) / (table[i] * 273.16 / 288.16), 1.0, 3e-3) << nm[i];
+        // 360-800 nm within 0.1 % (measured: 0.07 % at most); the table's last three
+        // entries (810-830 nm, as tabulated by clear-sky-models) are 1.2-2.8 % above
+        // the formula and its own lambda^-4 trend.
+        EXPECT_NEAR(PenndorfRayleigh(nm[i]) / (table[i] * 273.16 / 288.16), 1.0,
+                    nm[i] <= 800 ? 1e-3 : 3e-2)
+            << nm[i];
     }
     // kider-2013: Angstrom beta (lambda / 1 um)^-alpha / H, albedo 0.8.
     const SpectralAtmosphere k = LoadSpectralAtmosphere("kider-2013");
@@ -203,7 +208,7 @@ TEST(Spectral, LawsMatchTheirSources) {
     EXPECT_NEAR(e.absorption_extinction.At(600) / (300 * 2.687e20 / 15000.0 * 5.019e-25), 1.0,
                 1e-6);
     EXPECT_NEAR(e.rayleigh_scattering.At(500), 1.24062e-6 * 16.0, 1e-15);
-    EXPECT_NEAR(e.solar_irradiance.At(550), 1.8341, 1e-12);
+    EXPECT_NEAR(e.solar_irradiance.At(550), 1.8504, 1e-12);
 }
 
 TEST(Spectral, FlatSpectrumIntegratesToTheKnownWhite) {
