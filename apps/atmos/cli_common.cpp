@@ -80,6 +80,18 @@ double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphe
     return Seconds(start);
 }
 
+RenderRequest ViewRequest(const View& view, int width, int height, Quantity quantity,
+                          const MonteCarloSettings& monte_carlo) {
+    RenderRequest request;
+    request.view = view;
+    request.width = width;
+    request.height = height;
+    request.quantity = quantity;
+    request.show_progress = false;
+    request.monte_carlo = monte_carlo;
+    return request;
+}
+
 void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour) {
     cmd->add_option("--wavelengths", flags->wavelengths,
                     "spectral run: START:STOP:COUNT (nm, both ends included) or a list a,b,c; "

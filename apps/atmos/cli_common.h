@@ -14,6 +14,7 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
+#include "atmos/view.h"
 
 namespace atmos::cli {
 
@@ -58,6 +59,11 @@ struct SpectralFlags {
     std::string white = "d65";
 };
 void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour = true);
+
+// The request of one view at a size and quantity with Monte Carlo settings, no
+// progress bar (callers set the rest).
+RenderRequest ViewRequest(const View& view, int width, int height, Quantity quantity,
+                          const MonteCarloSettings& monte_carlo);
 
 // A registered subcommand: its CLI11 app and what runs it (returns the exit status).
 struct Command {

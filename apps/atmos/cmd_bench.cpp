@@ -125,13 +125,7 @@ int BenchSpectral(const BenchOptions& o, const std::vector<ModelSpec>& models,
         if (o.models.empty() && !HasSpectralForm(info)) continue;
         RequireSpectralModel(info);
         for (const View& view : views) {
-            RenderRequest request;
-            request.view = view;
-            request.width = width;
-            request.height = height;
-            request.quantity = quantity;
-            request.show_progress = false;
-            request.monte_carlo = monte_carlo;
+            RenderRequest request = ViewRequest(view, width, height, quantity, monte_carlo);
             std::vector<double> rp, rr, sp, sr;
             for (int i = 0; i < o.repeat; ++i) {
                 std::unique_ptr<Model> model = CreateModel(spec);
@@ -275,13 +269,7 @@ int CmdBench(const BenchOptions& o) {
         write_stages(name, "prepare", prepare_stages);
         const int64_t spp = stochastic ? monte_carlo.spp : 0;
         for (const View& view : views) {
-            RenderRequest request;
-            request.view = view;
-            request.width = width;
-            request.height = height;
-            request.quantity = quantity;
-            request.show_progress = false;
-            request.monte_carlo = monte_carlo;
+            RenderRequest request = ViewRequest(view, width, height, quantity, monte_carlo);
             Image image;
             std::vector<double> times;
             std::vector<StageRuns> frame_stages;

@@ -57,14 +57,8 @@ int RenderSpectralViews(const CommonOptions& common, const RenderOptions& ro,
     const SpectralAtmosphere atmosphere = LoadSpectralAtmosphere(common.atmosphere, common.sets);
     const bool all_views = ro.view == "all";
     for (const View& view : views) {
-        RenderRequest request;
-        request.view = view;
-        request.width = width;
-        request.height = height;
-        request.quantity = quantity;
+        RenderRequest request = ViewRequest(view, width, height, quantity, monte_carlo);
         request.sun_disc = ro.sun_disc;
-        request.show_progress = false;
-        request.monte_carlo = monte_carlo;
         const auto start = std::chrono::steady_clock::now();
         const SpectralImage spectral = RenderSpectral(
             GivenModel(common), atmosphere, nm, request,
@@ -130,14 +124,9 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     std::vector<GalleryEntry> gallery;
     if (all_views) fs::create_directories(ro.output);
     for (const View& view : views) {
-        RenderRequest request;
-        request.view = view;
-        request.width = width;
-        request.height = height;
-        request.quantity = quantity;
+        RenderRequest request = ViewRequest(view, width, height, quantity, monte_carlo);
         request.sun_disc = ro.sun_disc;
         request.show_progress = !common.quiet;
-        request.monte_carlo = monte_carlo;
         const bool stochastic = model->Info().capabilities.stochastic;
         Image variance;
         MonteCarloReport report;
