@@ -542,3 +542,20 @@ TEST(Cli, ValidateKiderOnTwoCaptures) {
     ExpectError("validate kider-2013 --data /nonexistent", "kider_ref.csv");
     ExpectError("validate other", "unknown data set");
 }
+
+// Issue 17: compare --wavelengths compares the spectral renders as linear sRGB.
+TEST(Cli, CompareWavelengths) {
+    const fs::path out = TempDir() / "compare_spectral";
+    const Result r = RunAtmos(
+        "compare -q --no-cache --models flat --reference naive --views ground-noon -s 8x5 "
+        "-a kider-2013 --wavelengths 400:700:4 -o " +
+        out.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string flip = Slurp(out / "flip.csv");
+    EXPECT_NE(flip.find("ground-noon,"), std::string::npos) << flip;
+    ExpectError(
+        "compare -q --no-cache --models preetham --reference naive --wavelengths 400:700:4 "
+        "-o " +
+            out.string(),
+        "per-wavelength");
+}
