@@ -218,6 +218,17 @@ TEST(Spectral, FlatSpectrumIntegratesToTheKnownWhite) {
     const Vec3d xyz = SpectrumToXyz(nm, WavelengthWeights(nm), ones.data());
     // The CIE functions have equal integrals (illuminant E: X = Y = Z), 106.86 nm.
     EXPECT_NEAR(xyz.y, 106.86, 0.1);
+    EXPECT_DOUBLE_EQ(CieYIntegral(), xyz.y);
+    // A spectral image of a flat spectrum: Y = the spectrum's value.
+    SpectralImage flat;
+    flat.width = flat.height = 1;
+    flat.nm = nm;
+    flat.values.assign(nm.size(), 0.25f);
+    EXPECT_NEAR(SpectralToColour(flat, ColourOutput::kXyz, WhitePoint::kD65).Get(0, 0).y, 0.25,
+                1e-6);
+    const Rgb grey = SpectralToColour(flat, ColourOutput::kSrgb, WhitePoint::kE).Get(0, 0);
+    EXPECT_NEAR(grey.x, 0.25, 1e-3);
+    EXPECT_NEAR(grey.z, 0.25, 1e-3);
     EXPECT_NEAR(xyz.x / xyz.y, 1.0, 2e-3);
     EXPECT_NEAR(xyz.z / xyz.y, 1.0, 2e-3);
     // White E: grey in sRGB; D65: D65's XYZ maps to (1, 1, 1).

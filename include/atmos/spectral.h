@@ -103,6 +103,9 @@ Vec3d Cie1931(double nm);
 Vec3d SpectrumToXyz(const std::vector<double>& nm, const std::vector<double>& weights,
                     const double* values, size_t stride = 1);
 
+// The integral of the CIE 1931 y function over its table, 360-830 nm (106.86 nm).
+double CieYIntegral();
+
 // The white of the XYZ -> linear sRGB conversion. kD65: the sRGB matrix of
 // IEC 61966-2-1 as is (an equal-energy spectrum comes out slightly pink);
 // kE: Bradford adaptation from the equal-energy white E to D65 first (an

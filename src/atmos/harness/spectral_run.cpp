@@ -109,7 +109,9 @@ ColourOutput ParseColourOutput(const std::string& text) {
 Image SpectralToColour(const SpectralImage& image, ColourOutput colour, WhitePoint white) {
     Image out(image.width, image.height);
     const size_t n = image.nm.size();
-    const std::vector<double> weights = WavelengthWeights(image.nm);
+    std::vector<double> weights = WavelengthWeights(image.nm);
+    const double y_integral = CieYIntegral();
+    for (double& w : weights) w /= y_integral;
     std::vector<double> spectrum(n);
     const size_t pixels = static_cast<size_t>(image.width) * image.height;
     for (size_t p = 0; p < pixels; ++p) {

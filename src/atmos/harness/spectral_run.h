@@ -53,8 +53,9 @@ enum class ColourOutput { kSrgb, kXyz };
 ColourOutput ParseColourOutput(const std::string& text);  // "srgb" or "xyz"
 
 // The image's colour: XYZ through the CIE 1931 functions (weights
-// WavelengthWeights), as XYZ or linear sRGB with `white`. In the solar
-// spectrum's units: x 683 for cd m^-2 when the spectrum is in W m^-2 nm^-1.
+// WavelengthWeights) divided by CieYIntegral() (106.86 nm), so that a flat
+// spectrum of value L has Y = L (the units of the spectrum: x 683 x 106.86 for
+// cd m^-2 when it is in W m^-2 sr^-1 nm^-1), as XYZ or linear sRGB with `white`.
 Image SpectralToColour(const SpectralImage& image, ColourOutput colour, WhitePoint white);
 
 // The spectral EXR of Fichet, Pacanowski and Wilkie, "An OpenEXR Layout for

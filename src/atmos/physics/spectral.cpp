@@ -322,6 +322,15 @@ Vec3d SpectrumToXyz(const std::vector<double>& nm, const std::vector<double>& we
     return xyz;
 }
 
+double CieYIntegral() {
+    static const double integral = [] {
+        const Cmf& c = CieTable();
+        const std::vector<double> ones(c.nm.size(), 1.0);
+        return SpectrumToXyz(c.nm, WavelengthWeights(c.nm), ones.data()).y;
+    }();
+    return integral;
+}
+
 WhitePoint ParseWhitePoint(const std::string& text) {
     if (text == "d65") return WhitePoint::kD65;
     if (text == "e") return WhitePoint::kE;
