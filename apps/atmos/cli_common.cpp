@@ -83,4 +83,32 @@ double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphe
     return Seconds(start);
 }
 
+RenderRequest ViewRequest(const View& view, int width, int height, Quantity quantity,
+                          const MonteCarloSettings& monte_carlo) {
+    RenderRequest request;
+    request.view = view;
+    request.width = width;
+    request.height = height;
+    request.quantity = quantity;
+    request.show_progress = false;
+    request.monte_carlo = monte_carlo;
+    return request;
+}
+
+void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour) {
+    cmd->add_option("--wavelengths", flags->wavelengths,
+                    "spectral run: START:STOP:COUNT (nm, both ends included) or a list a,b,c; "
+                    "the atmosphere is evaluated at each wavelength and the model run in "
+                    "batches of three");
+    if (!colour) return;
+    cmd->add_option("--colour", flags->colour,
+                    "with --wavelengths: the colour of the RGB output, srgb (linear) or xyz "
+                    "(CIE 1931 2-degree)")
+        ->capture_default_str();
+    cmd->add_option("--white", flags->white,
+                    "with --wavelengths and --colour srgb: d65 (the sRGB matrix as is) or e "
+                    "(Bradford from the equal-energy white: a flat spectrum is grey)")
+        ->capture_default_str();
+}
+
 }  // namespace atmos::cli

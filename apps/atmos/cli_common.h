@@ -14,6 +14,7 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
+#include "atmos/view.h"
 
 namespace atmos::cli {
 
@@ -50,6 +51,20 @@ double Seconds(std::chrono::steady_clock::time_point since);
 // --load; returns the seconds it took.
 double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphere, Model* model);
 
+// --wavelengths, --colour, --white (render, sample, compare, bench): a spectral run
+// (harness/spectral_run.h) when `wavelengths` is not empty.
+struct SpectralFlags {
+    std::string wavelengths;
+    std::string colour = "srgb";
+    std::string white = "d65";
+};
+void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour = true);
+
+// The request of one view at a size and quantity with Monte Carlo settings, no
+// progress bar (callers set the rest).
+RenderRequest ViewRequest(const View& view, int width, int height, Quantity quantity,
+                          const MonteCarloSettings& monte_carlo);
+
 // A registered subcommand: its CLI11 app and what runs it (returns the exit status).
 struct Command {
     CLI::App* app = nullptr;
@@ -69,5 +84,6 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv);
 Command AddBenchCommand(CLI::App* root);
 Command AddLocCommand(CLI::App* root);
 Command AddFitCommand(CLI::App* root);
+Command AddValidateCommand(CLI::App* root);
 
 }  // namespace atmos::cli

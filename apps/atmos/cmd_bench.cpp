@@ -35,11 +35,13 @@
 #include "atmos/atmosphere.h"
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "atmos/spectral.h"
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "cli_monte_carlo.h"
 #include "harness/machine.h"
+#include "harness/spectral_run.h"
 #include "render/stages.h"
 
 namespace fs = std::filesystem;
@@ -63,6 +65,7 @@ struct BenchOptions {
     CLI::Option* repeat_flag = nullptr;
     CLI::Option* warmup_flag = nullptr;
     MonteCarloFlags monte_carlo;
+    SpectralFlags spectral;
 };
 
 double Median(std::vector<double> v) {
@@ -103,6 +106,65 @@ std::string CsvField(const std::string& s) {
     return q + "\"";
 }
 
+// --wavelengths: per model and view, the RGB run (Prepare + one render) against the
+// spectral run (every batch's Prepare + render), wall time, median of --repeat.
+int BenchSpectral(const BenchOptions& o, const std::vector<ModelSpec>& models,
+                  const std::vector<View>& views, int width, int height, Quantity quantity,
+                  const MonteCarloSettings& monte_carlo) {
+    const std::vector<double> nm = ParseWavelengths(o.spectral.wavelengths);
+    const SpectralAtmosphere spectral = LoadSpectralAtmosphere(o.atmosphere, o.sets);
+    const AtmosphereParameters rgb = LoadAtmosphere(o.atmosphere, o.sets);
+    if (fs::path(o.output).has_parent_path())
+        fs::create_directories(fs::path(o.output).parent_path());
+    std::ofstream csv(o.output);
+    if (!csv) Fail("cannot write '", o.output, "'");
+    csv << "model,view,width,height,wavelengths,batches,threads,rgb_prepare_s,rgb_render_s,"
+           "spectral_prepare_s,spectral_render_s,prepare_ratio,render_ratio,repeat\n";
+    for (const ModelSpec& spec : models) {
+        const ModelInfo info = GetModelInfo(spec.name);
+        if (o.models.empty() && !HasSpectralForm(info)) continue;
+        RequireSpectralModel(info);
+        for (const View& view : views) {
+            RenderRequest request = ViewRequest(view, width, height, quantity, monte_carlo);
+            std::vector<double> rp, rr, sp, sr;
+            for (int i = 0; i < o.repeat; ++i) {
+                std::unique_ptr<Model> model = CreateModel(spec);
+                auto t0 = std::chrono::steady_clock::now();
+                model->Prepare(rgb);
+                rp.push_back(Seconds(t0));
+                Image image;
+                t0 = std::chrono::steady_clock::now();
+                model->Render(request, &image);
+                rr.push_back(Seconds(t0));
+                double prepare_s = 0.0;
+                t0 = std::chrono::steady_clock::now();
+                RenderSpectral(spec, spectral, nm, request,
+                               [&](const AtmosphereParameters& a, Model* m) {
+                                   const auto p0 = std::chrono::steady_clock::now();
+                                   m->Prepare(a);
+                                   prepare_s += Seconds(p0);
+                               });
+                const double total = Seconds(t0);
+                sp.push_back(prepare_s);
+                sr.push_back(total - prepare_s);
+            }
+            const double a = Median(rp), b = Median(rr), c = Median(sp), d = Median(sr);
+            csv << CsvField(spec.text) << "," << view.name << "," << width << "," << height << ","
+                << nm.size() << "," << (nm.size() + 2) / 3 << "," << ParallelThreadCount() << ","
+                << a << "," << b << "," << c << "," << d << "," << (a > 0 ? c / a : 0.0) << ","
+                << (b > 0 ? d / b : 0.0) << "," << o.repeat << "\n";
+            std::printf(
+                "%-24s %-18s RGB prepare %8.3f s render %8.3f s | %zu wavelengths: "
+                "prepare %8.3f s (x%.1f) render %8.3f s (x%.1f)\n",
+                spec.text.c_str(), view.name.c_str(), a, b, nm.size(), c, a > 0 ? c / a : 0.0, d,
+                b > 0 ? d / b : 0.0);
+        }
+    }
+    if (!csv) Fail("cannot write '", o.output, "'");
+    std::printf("wrote %s\n", o.output.c_str());
+    return 0;
+}
+
 int CmdBench(const BenchOptions& o) {
     int width = 0, height = 0;
     ParseSize(o.size, &width, &height);
@@ -140,6 +202,9 @@ int CmdBench(const BenchOptions& o) {
     ThreadLimit limit(o.threads);
     const Backend backend = ParseBackend(o.backend);
     const BackendScope backend_scope(backend);
+    if (!o.spectral.wavelengths.empty()) {
+        return BenchSpectral(o, models, views, width, height, quantity, monte_carlo);
+    }
     const bool on_device = backend == Backend::kCuda;
     const int repeat = on_device && o.repeat_flag->count() == 0 ? 256 : o.repeat;
     const int warmup = on_device && o.warmup_flag->count() == 0 ? 16 : o.warmup;
@@ -204,13 +269,7 @@ int CmdBench(const BenchOptions& o) {
         write_stages(name, "prepare", prepare_stages);
         const int64_t spp = stochastic ? monte_carlo.spp : 0;
         for (const View& view : views) {
-            RenderRequest request;
-            request.view = view;
-            request.width = width;
-            request.height = height;
-            request.quantity = quantity;
-            request.show_progress = false;
-            request.monte_carlo = monte_carlo;
+            RenderRequest request = ViewRequest(view, width, height, quantity, monte_carlo);
             Image image;
             std::vector<double> times;
             std::vector<StageRuns> frame_stages;
@@ -300,6 +359,7 @@ Command AddBenchCommand(CLI::App* root) {
         ->check(CLI::Range(0, 4096));  // (NonNegativeNumber printed a 309-digit bound)
     cmd->add_option("-o,--output", o->output, "CSV file")->capture_default_str();
     AddMonteCarloFlags(cmd, &o->monte_carlo);
+    AddSpectralFlags(cmd, &o->spectral, false);
     Command c;
     c.app = cmd;
     c.run = [o] { return CmdBench(*o); };

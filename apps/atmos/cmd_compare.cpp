@@ -11,9 +11,11 @@
 #include "atmos/atmosphere.h"
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "atmos/spectral.h"
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "harness/compare.h"
+#include "harness/spectral_run.h"
 #include "io/output_path.h"
 #include "render/progressive.h"
 
@@ -53,6 +55,7 @@ struct CompareCliOptions {
     std::string tone_mapper = "aces";
     std::string exposure = "atmos";
     std::string command_line;
+    SpectralFlags spectral;
 };
 
 bool IsRegistered(const std::string& name) {
@@ -72,6 +75,16 @@ int CmdCompare(const CompareCliOptions& o) {
     for (const std::string& m : o.models) ParseModelSpec(m);                  // fail early
     config.atmosphere_name = o.atmosphere;
     config.atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
+    if (!o.spectral.wavelengths.empty()) {
+        // Spectral: every model and the reference at the wavelengths, as linear sRGB
+        // (harness/spectral_run.h); the render cache is not used.
+        if (o.spectral.colour != "srgb") Fail("compare --wavelengths compares --colour srgb");
+        config.wavelengths = ParseWavelengths(o.spectral.wavelengths);
+        config.spectral_atmosphere = LoadSpectralAtmosphere(o.atmosphere, o.sets);
+        config.white = ParseWhitePoint(o.spectral.white);
+        for (const std::string& m : o.models)
+            RequireSpectralModel(GetModelInfo(ParseModelSpec(m).name));
+    }
     config.output_dir = !o.output.empty()                             ? o.output
                         : config.quantity == Quantity::kTransmittance ? "out/transmittance"
                                                                       : "out";
@@ -200,6 +213,7 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
         ->check(CLI::Range(0, 4096));  // (NonNegativeNumber printed a 309-digit bound)
     cmd->add_flag("--quiet,-q", o->quiet, "no progress lines");
     AddBackendOption(cmd, &o->backend);
+    AddSpectralFlags(cmd, &o->spectral);
     Command c;
     c.app = cmd;
     c.run = [o] { return CmdCompare(*o); };

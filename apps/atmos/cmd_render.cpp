@@ -16,11 +16,13 @@
 #include "atmos/error.h"
 #include "atmos/image.h"
 #include "atmos/model.h"
+#include "atmos/spectral.h"
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "cli_monte_carlo.h"
 #include "harness/gallery.h"
+#include "harness/spectral_run.h"
 #include "io/output_path.h"
 
 namespace fs = std::filesystem;
@@ -40,7 +42,45 @@ struct RenderOptions {
     bool resume = false;
     bool keep_checkpoint = false;
     MonteCarloFlags monte_carlo;
+    SpectralFlags spectral;
 };
+
+// --wavelengths: the views rendered at each wavelength (harness/spectral_run.h);
+// OUTPUT gets the colour (--colour, --white), STEM.spectral.exr the spectrum.
+int RenderSpectralViews(const CommonOptions& common, const RenderOptions& ro,
+                        const std::vector<View>& views, int width, int height, Quantity quantity,
+                        const MonteCarloSettings& monte_carlo) {
+    if (!common.load.empty()) Fail("--load cannot be combined with --wavelengths");
+    const std::vector<double> nm = ParseWavelengths(ro.spectral.wavelengths);
+    const ColourOutput colour = ParseColourOutput(ro.spectral.colour);
+    const WhitePoint white = ParseWhitePoint(ro.spectral.white);
+    const SpectralAtmosphere atmosphere = LoadSpectralAtmosphere(common.atmosphere, common.sets);
+    const bool all_views = ro.view == "all";
+    for (const View& view : views) {
+        RenderRequest request = ViewRequest(view, width, height, quantity, monte_carlo);
+        request.sun_disc = ro.sun_disc;
+        const auto start = std::chrono::steady_clock::now();
+        const SpectralImage spectral = RenderSpectral(
+            GivenModel(common), atmosphere, nm, request,
+            [&](const AtmosphereParameters& a, Model* model) { PrepareModel(common, a, model); });
+        const double seconds = Seconds(start);
+        const Image image = SpectralToColour(spectral, colour, white);
+        const std::string output =
+            all_views ? (fs::path(ro.output) / (common.model + "-" + view.name + ".exr")).string()
+                      : ro.output;
+        const std::string stem = fs::path(output).replace_extension().string();
+        WriteImage(image, output, ro.exposure > 0.0f ? ro.exposure : view.exposure);
+        WriteSpectralExr(spectral, stem + ".spectral.exr");
+        if (!common.quiet) {
+            std::fprintf(stderr,
+                         "rendered %-22s %dx%d with %s at %zu wavelengths (%zu batches) in "
+                         "%.3f s; wrote %s and %s.spectral.exr\n",
+                         view.name.c_str(), width, height, common.model.c_str(), nm.size(),
+                         (nm.size() + 2) / 3, seconds, output.c_str(), stem.c_str());
+        }
+    }
+    return 0;
+}
 
 int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     int width = 0, height = 0;
@@ -72,6 +112,10 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         views.push_back(GetView(ro.view, atmosphere));
     }
 
+    if (!ro.spectral.wavelengths.empty()) {
+        if (all_views) fs::create_directories(ro.output);
+        return RenderSpectralViews(common, ro, views, width, height, quantity, monte_carlo);
+    }
     const double prepare_seconds = PrepareModel(common, atmosphere, model.get());
     if (!common.quiet && prepare_seconds > 0.01) {
         std::fprintf(stderr, "prepared %s in %.3f s\n", common.model.c_str(), prepare_seconds);
@@ -80,14 +124,9 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     std::vector<GalleryEntry> gallery;
     if (all_views) fs::create_directories(ro.output);
     for (const View& view : views) {
-        RenderRequest request;
-        request.view = view;
-        request.width = width;
-        request.height = height;
-        request.quantity = quantity;
+        RenderRequest request = ViewRequest(view, width, height, quantity, monte_carlo);
         request.sun_disc = ro.sun_disc;
         request.show_progress = !common.quiet;
-        request.monte_carlo = monte_carlo;
         const bool stochastic = model->Info().capabilities.stochastic;
         Image variance;
         MonteCarloReport report;
@@ -179,6 +218,7 @@ Command AddRenderCommand(CLI::App* root) {
     render->add_flag("--resume", ro->resume,
                      "Monte Carlo models: continue from the checkpoint of the same render");
     AddMonteCarloFlags(render, &ro->monte_carlo, true);
+    AddSpectralFlags(render, &ro->spectral);
     c.app = render;
     c.run = [common, ro] { return CmdRender(*common, *ro); };
     return c;

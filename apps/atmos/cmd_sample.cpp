@@ -15,6 +15,7 @@
 #include "atmos/image.h"
 #include "atmos/model.h"
 #include "atmos/number.h"
+#include "atmos/spectral.h"
 #include "atmos/view.h"
 #include "base/library_progress.h"
 #include "base/parallel.h"
@@ -23,6 +24,7 @@
 #include "harness/gallery.h"
 #include "io/image_formats.h"
 #include "render/progressive.h"
+#include "sample_spectral.h"
 
 namespace atmos::cli {
 
@@ -209,9 +211,18 @@ struct SampleIo {
     std::string input, output;
 };
 
-int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const SampleIo& io) {
+int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const SampleIo& io,
+              const SpectralFlags& spectral) {
     ThreadLimit limit(common.threads);
     const BackendScope backend(ParseBackend(common.backend));
+    if (!spectral.wavelengths.empty()) {
+        ParseWavelengths(spectral.wavelengths);  // fail before reading stdin
+        const MonteCarloSettings mc = flags.Settings(CreateModel(GivenModel(common))->Info());
+        if (!io.output.empty() && io.output != "-") {
+            Fail("--output is not supported with --wavelengths: the spectral columns go to stdout");
+        }
+        return SampleSpectralCsv(common, mc, spectral.wavelengths, ReadQueries(io.input));
+    }
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(GivenModel(common));
     const MonteCarloSettings monte_carlo = flags.Settings(model->Info());
@@ -231,6 +242,7 @@ Command AddSampleCommand(CLI::App* root) {
     auto common = std::make_shared<CommonOptions>();
     auto flags = std::make_shared<MonteCarloFlags>();
     auto io = std::make_shared<SampleIo>();
+    auto spectral = std::make_shared<SpectralFlags>();
     Command c;
     c.app = root->add_subcommand(
         "sample", "evaluate a model at queries read as CSV from stdin, answers to stdout");
@@ -244,7 +256,8 @@ Command AddSampleCommand(CLI::App* root) {
         "--output,-o", io->output,
         "answers: a CSV file, or NPY (float32, shape (N, 6): L_r,L_g,L_b,T_r,T_g,T_b) "
         "(default: CSV to stdout)");
-    c.run = [common, flags, io] { return CmdSample(*common, *flags, *io); };
+    AddSpectralFlags(c.app, spectral.get(), false);
+    c.run = [common, flags, io, spectral] { return CmdSample(*common, *flags, *io, *spectral); };
     return c;
 }
 

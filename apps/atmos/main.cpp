@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
         AddViewerCommand(&app), AddFlipCommand(&app),
         AddRmseCommand(&app),   AddCompareCommand(&app, argc, argv),
         AddBenchCommand(&app),  AddLocCommand(&app),
-        AddFitCommand(&app),
+        AddFitCommand(&app),    AddValidateCommand(&app),
     };
     try {
         if (argc > 1 && argv[1][0] != '-') {

@@ -10,5 +10,8 @@ struct EmbeddedPreset {
 // Terminated by {nullptr, nullptr}; kEmbeddedPresetCount excludes the terminator.
 extern const EmbeddedPreset kEmbeddedPresets[];
 extern const int kEmbeddedPresetCount;
+// The spectral tables of data/spectra/*.csv (name without ".csv", the CSV text).
+extern const EmbeddedPreset kEmbeddedSpectra[];
+extern const int kEmbeddedSpectrumCount;
 
 }  // namespace atmos::detail

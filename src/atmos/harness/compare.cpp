@@ -14,6 +14,7 @@
 #include "harness/ranking.h"
 #include "harness/render_cache.h"
 #include "harness/report.h"
+#include "harness/spectral_run.h"
 #include "metrics/rmse.h"
 
 namespace fs = std::filesystem;
@@ -77,6 +78,7 @@ class LazyRenderer {
         Image image;
         MonteCarloReport local;
         if (!report) report = &local;
+        if (!config_.wavelengths.empty()) return RenderSpectralColour(view, seconds, cached);
         if (cache_.Load(key, &image, seconds, report, variance)) {
             *cached = true;
             return image;
@@ -123,6 +125,32 @@ class LazyRenderer {
     }
 
   private:
+    // --wavelengths: the view at every wavelength, as linear sRGB (Prepare per
+    // batch and view, counted in prepare_seconds).
+    Image RenderSpectralColour(const View& view, double* seconds, bool* cached) {
+        RenderRequest request;
+        request.view = view;
+        request.width = config_.width;
+        request.height = config_.height;
+        request.quantity = config_.quantity;
+        request.show_progress = false;
+        request.monte_carlo = monte_carlo_;
+        double prepare = 0.0;
+        const auto start = std::chrono::steady_clock::now();
+        const SpectralImage spectral = RenderSpectral(
+            ModelSpec{name_, name_, options_}, config_.spectral_atmosphere, config_.wavelengths,
+            request, [&](const AtmosphereParameters& a, Model* m) {
+                const auto p0 = std::chrono::steady_clock::now();
+                m->Prepare(a);
+                prepare += SecondsSince(p0);
+            });
+        *seconds = SecondsSince(start) - prepare;
+        prepare_seconds_ += prepare;
+        prepared_ = true;
+        *cached = false;
+        return SpectralToColour(spectral, ColourOutput::kSrgb, config_.white);
+    }
+
     std::string name_;
     std::map<std::string, std::string> options_;
     const CompareConfig& config_;

@@ -16,6 +16,7 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
+#include "atmos/spectral.h"
 #include "atmos/view.h"
 #include "harness/loc.h"
 #include "harness/profiles.h"
@@ -40,6 +41,13 @@ struct CompareConfig {
     std::string reference_note;  // how the reference was chosen (shown in the report)
     std::string atmosphere_name = "earth";
     AtmosphereParameters atmosphere;
+    // Spectral comparison (--wavelengths; harness/spectral_run.h): every model and
+    // the reference rendered at these wavelengths of `spectral_atmosphere` (each
+    // view re-prepares the batches; no render cache) and compared as linear sRGB
+    // with `white`. Empty: the RGB comparison.
+    std::vector<double> wavelengths;
+    SpectralAtmosphere spectral_atmosphere;
+    WhitePoint white = WhitePoint::kD65;
     std::string output_dir = "out";
     std::string cache_dir;  // empty: no cache
     FlipOptions flip;

@@ -25,6 +25,7 @@
 #include "atmos/atmosphere.h"
 #include "atmos/embedded_presets.h"
 #include "atmos/error.h"
+#include "atmos/spectral.h"
 
 namespace atmos {
 
@@ -197,6 +198,250 @@ DensityProfile ReadDensity(const Json& node, const std::string& where, const std
         return profile;
     }
     Fail(where, ": unknown field '", path, ".", key, "' (", kDensityForms, ")");
+}
+
+// ---------------------------------------------------------------------------------------
+// Spectral fields (include/atmos/spectral.h). A wavelength-dependent field may be an
+// object with one key (docs/atmosphere.md "Spectral fields"); ResolveSpectra parses
+// those into spectra and replaces each by its values at 680/550/440 nm, so that
+// the rest of the reader (and every RGB user) sees an RGB atmosphere.
+
+constexpr const char* kSpectralFields[] = {"rayleigh_scattering", "mie_extinction",
+                                           "mie_scattering",      "absorption_extinction",
+                                           "ground_albedo",       "solar_irradiance"};
+
+const char kSpectrumForms[] =
+    "a spectrum is a number, [r, g, b], {\"table\": ...}, {\"penndorf\": {...}}, "
+    "{\"power_law\": {...}}, {\"angstrom\": {...}}, {\"single_scattering_albedo\": ...} "
+    "(mie_scattering) or {\"ozone\": {...}} (absorption_extinction)";
+
+void CheckKeys(const Json& node, const std::string& where, const std::string& path,
+               const std::vector<std::string>& allowed) {
+    if (!node.is_object()) Fail(where, ": field '", path, "' must be an object");
+    for (const auto& item : node.items()) {
+        if (std::find(allowed.begin(), allowed.end(), item.key()) == allowed.end()) {
+            Fail(where, ": unknown field '", path, ".", item.key(), "' (", path, " has ",
+                 Join(allowed, ", "), ")");
+        }
+    }
+}
+
+double ReadPositive(const Json& node, const std::string& key, const std::string& where,
+                    const std::string& path, bool allow_zero) {
+    if (!node.contains(key)) Fail(where, ": field '", path, ".", key, "' is missing");
+    const double v = ReadNumber(node[key], where, path + "." + key);
+    if (!std::isfinite(v) || v < 0.0 || (!allow_zero && v == 0.0)) {
+        Fail(where, ": field '", path, ".", key, "' must be a finite number ",
+             allow_zero ? ">= 0" : "> 0");
+    }
+    return v;
+}
+
+std::vector<double> ReadNumberArray(const Json& node, const std::string& where,
+                                    const std::string& path) {
+    if (!node.is_array() || node.empty()) {
+        Fail(where, ": field '", path, "' must be a non-empty array of numbers");
+    }
+    std::vector<double> values;
+    for (size_t i = 0; i < node.size(); ++i) {
+        values.push_back(ReadNumber(node[i], where, path + "[" + std::to_string(i) + "]"));
+        if (!std::isfinite(values.back())) {
+            Fail(where, ": field '", path, "[", i, "]' must be a finite number");
+        }
+    }
+    return values;
+}
+
+Spectrum ReadTable(const Json& node, const std::string& where, const std::string& path) {
+    if (node.is_string()) {
+        std::vector<double> nm, values;
+        try {
+            SpectralDataTable(node.get<std::string>(), 0, &nm, &values);
+        } catch (const Error& e) {
+            Fail(where, ": field '", path, "': ", e.what());
+        }
+        return Spectrum::Table(nm, values);
+    }
+    CheckKeys(node, where, path, {"nm", "value", "name", "scale"});
+    std::vector<double> nm, values;
+    if (node.contains("name")) {
+        if (node.contains("nm") || node.contains("value")) {
+            Fail(where, ": field '", path, "' takes either name or nm and value");
+        }
+        if (!node["name"].is_string()) Fail(where, ": field '", path, ".name' must be a string");
+        try {
+            SpectralDataTable(node["name"].get<std::string>(), 0, &nm, &values);
+        } catch (const Error& e) {
+            Fail(where, ": field '", path, ".name': ", e.what());
+        }
+    } else {
+        if (!node.contains("nm")) Fail(where, ": field '", path, ".nm' is missing");
+        if (!node.contains("value")) Fail(where, ": field '", path, ".value' is missing");
+        nm = ReadNumberArray(node["nm"], where, path + ".nm");
+        values = ReadNumberArray(node["value"], where, path + ".value");
+        if (nm.size() != values.size()) {
+            Fail(where, ": field '", path, "': nm has ", nm.size(), " entries and value ",
+                 values.size());
+        }
+        for (size_t i = 1; i < nm.size(); ++i) {
+            if (!(nm[i] > nm[i - 1])) {
+                Fail(where, ": field '", path, ".nm' must increase strictly (entry ", i, ")");
+            }
+        }
+    }
+    const double scale =
+        node.contains("scale") ? ReadPositive(node, "scale", where, path, true) : 1.0;
+    return Spectrum::Table(nm, values, scale);
+}
+
+// The integral of a density profile over [0, top - bottom] (m): 10^5 midpoint steps.
+double DensityIntegral(const DensityProfile& profile, double height) {
+    auto density = [&](double h) {
+        const DensityProfileLayer& l =
+            h < profile.layers[0].width ? profile.layers[0] : profile.layers[1];
+        const double e = l.exp_term == 0.0 ? 0.0 : l.exp_term * std::exp(l.exp_scale * h);
+        return std::clamp(e + l.linear_term * h + l.constant_term, 0.0, 1.0);
+    };
+    constexpr int kSteps = 100000;
+    const double dh = height / kSteps;
+    double sum = 0.0;
+    for (int i = 0; i < kSteps; ++i) sum += density((i + 0.5) * dh);
+    return sum * dh;
+}
+
+Spectrum ReadSpectrum(const Json& node, const Json& root, const std::string& field,
+                      const std::string& where, const std::string& path,
+                      const Spectrum* mie_extinction) {
+    if (!node.is_object()) return Spectrum::FromRgb(ReadRgb(node, where, path));
+    if (node.size() != 1) {
+        Fail(where, ": field '", path, "' must be an object with exactly one key (", kSpectrumForms,
+             ")");
+    }
+    const std::string key = node.begin().key();
+    const Json& value = node.begin().value();
+    const std::string sub = path + "." + key;
+    if (key == "table") return ReadTable(value, where, sub);
+    if (key == "penndorf") {
+        CheckKeys(value, where, sub, {"scale"});
+        Spectrum s;
+        SpectralTerm t;
+        t.kind = SpectralTerm::Kind::kPenndorf;
+        t.value = value.contains("scale") ? ReadPositive(value, "scale", where, sub, true) : 1.0;
+        s.terms.push_back(t);
+        return s;
+    }
+    if (key == "power_law") {
+        CheckKeys(value, where, sub, {"value", "reference_nm", "exponent"});
+        Spectrum s;
+        SpectralTerm t;
+        t.kind = SpectralTerm::Kind::kPowerLaw;
+        t.value = ReadPositive(value, "value", where, sub, true);
+        t.reference_nm = ReadPositive(value, "reference_nm", where, sub, false);
+        if (!value.contains("exponent")) Fail(where, ": field '", sub, ".exponent' is missing");
+        t.exponent = ReadNumber(value["exponent"], where, sub + ".exponent");
+        if (!std::isfinite(t.exponent) || std::abs(t.exponent) > 10.0) {
+            Fail(where, ": field '", sub, ".exponent' must be in [-10, 10]");
+        }
+        s.terms.push_back(t);
+        return s;
+    }
+    if (key == "angstrom" && (field == "mie_extinction" || field == "mie_scattering")) {
+        CheckKeys(value, where, sub, {"alpha", "beta", "scale_height"});
+        if (!value.contains("alpha")) Fail(where, ": field '", sub, ".alpha' is missing");
+        const double alpha = ReadNumber(value["alpha"], where, sub + ".alpha");
+        if (!std::isfinite(alpha) || std::abs(alpha) > 10.0) {
+            Fail(where, ": field '", sub, ".alpha' must be in [-10, 10]");
+        }
+        const double beta = ReadPositive(value, "beta", where, sub, true);
+        double scale_height = 0.0;
+        if (value.contains("scale_height")) {
+            scale_height = ReadPositive(value, "scale_height", where, sub, false);
+        } else {
+            const Json& mie_density = root.contains("mie_density") ? root["mie_density"] : Json();
+            if (!mie_density.is_object() || !mie_density.contains("scale_height")) {
+                Fail(where, ": field '", sub,
+                     ".scale_height' is missing (needed unless mie_density is "
+                     "{\"scale_height\": H})");
+            }
+            scale_height = ReadPositive(mie_density, "scale_height", where, "mie_density", false);
+        }
+        // beta_ext(lambda) = beta (lambda / 1000 nm)^-alpha / H: beta is the optical
+        // depth of the exponential column at 1 um.
+        Spectrum s;
+        SpectralTerm t;
+        t.kind = SpectralTerm::Kind::kPowerLaw;
+        t.value = beta / scale_height;
+        t.reference_nm = 1000.0;
+        t.exponent = alpha;
+        s.terms.push_back(t);
+        return s;
+    }
+    if (key == "single_scattering_albedo" && field == "mie_scattering") {
+        Spectrum albedo = ReadSpectrum(value, root, "albedo", where, sub, nullptr);
+        Spectrum s = *mie_extinction;
+        s.terms.insert(s.terms.end(), albedo.terms.begin(), albedo.terms.end());
+        return s;
+    }
+    if (key == "ozone" && field == "absorption_extinction") {
+        CheckKeys(value, where, sub, {"dobson", "number_density", "cross_section"});
+        if (value.contains("dobson") == value.contains("number_density")) {
+            Fail(where, ": field '", sub, "' takes one of dobson and number_density");
+        }
+        if (!value.contains("cross_section")) {
+            Fail(where, ": field '", sub, ".cross_section' is missing");
+        }
+        double number_density = 0.0;  // molecules per m^3 at density 1
+        if (value.contains("number_density")) {
+            number_density = ReadPositive(value, "number_density", where, sub, true);
+        } else {
+            // 1 Dobson unit = 2.687e20 molecules per m^2 (Bruneton 2017's demo,
+            // kDobsonUnit); the peak density is the column over the profile's integral.
+            const double dobson = ReadPositive(value, "dobson", where, sub, true);
+            if (!root.contains("absorption_density")) {
+                Fail(where, ": field 'absorption_density' is missing");
+            }
+            const DensityProfile profile =
+                ReadDensity(root["absorption_density"], where, "absorption_density");
+            const double bottom =
+                ReadNumber(root.value("bottom_radius", Json(0.0)), where, "bottom_radius");
+            const double top = ReadNumber(root.value("top_radius", Json(0.0)), where, "top_radius");
+            const double integral = DensityIntegral(profile, std::max(top - bottom, 0.0));
+            if (!(integral > 0.0)) {
+                Fail(where, ": field '", sub,
+                     ".dobson' needs an absorption_density with a non-zero column");
+            }
+            number_density = dobson * 2.687e20 / integral;
+        }
+        Spectrum s = ReadSpectrum(value["cross_section"], root, "cross_section", where,
+                                  sub + ".cross_section", nullptr);
+        SpectralTerm t;
+        t.value = number_density;
+        s.terms.push_back(t);
+        return s;
+    }
+    Fail(where, ": unknown field '", sub, "' (", kSpectrumForms, ")");
+}
+
+// Parses the spectral fields of `root` into `out` (may be null) and replaces each
+// by its values at kRgbWavelengths.
+void ResolveSpectra(Json& root, const std::string& where, SpectralAtmosphere* out) {
+    if (!root.is_object()) return;
+    SpectralAtmosphere local;
+    SpectralAtmosphere& s = out != nullptr ? *out : local;
+    Spectrum* targets[] = {&s.rayleigh_scattering,   &s.mie_extinction, &s.mie_scattering,
+                           &s.absorption_extinction, &s.ground_albedo,  &s.solar_irradiance};
+    for (size_t i = 0; i < std::size(kSpectralFields); ++i) {
+        const char* field = kSpectralFields[i];
+        if (!root.contains(field)) continue;  // ReadTree names the missing field
+        Json& node = root[field];
+        if (node.is_object()) s.spectral = true;
+        *targets[i] = ReadSpectrum(node, root, field, where, field, &s.mie_extinction);
+        if (node.is_object()) {
+            node =
+                Json::array({targets[i]->At(kRgbWavelengths[0]), targets[i]->At(kRgbWavelengths[1]),
+                             targets[i]->At(kRgbWavelengths[2])});
+        }
+    }
 }
 
 AtmosphereParameters ReadTree(const Json& root, const std::string& where) {
@@ -381,6 +626,21 @@ void ApplyOverride(Json& root, const std::string& text, const std::string& where
         return;
     }
     if (spec->kind == FieldKind::kScalar) FailUnknownField(field, text, "");
+    if (spec->kind == FieldKind::kRgb && node.is_object()) {
+        // A spectral field: FIELD.KEY.KEY...=VALUE sets that member of its object
+        // (e.g. mie_extinction.angstrom.beta=0.05); the reader validates the result.
+        Json* target = &node;
+        for (size_t i = 1; i < path.size(); ++i) {
+            if (!target->is_object() || !target->contains(path[i])) {
+                Fail("--set ", text, ": field '", path[0], "' has no member '",
+                     Join(std::vector<std::string>(path.begin() + 1, path.begin() + i + 1), "."),
+                     "'");
+            }
+            target = &(*target)[path[i]];
+        }
+        *target = value;
+        return;
+    }
     if (spec->kind == FieldKind::kRgb) {
         int channel = 0;
         if (path.size() != 2 || !ParseIndex(path[1], 3, &channel)) {
@@ -446,8 +706,10 @@ void ApplyOverride(Json& root, const std::string& text, const std::string& where
 
 AtmosphereParameters AtmosphereFromJson(const std::string& json_text,
                                         const std::string& source_name) {
-    const Json root = ParseText(json_text, source_name);
-    return ReadTree(root, "atmosphere '" + source_name + "'");
+    Json root = ParseText(json_text, source_name);
+    const std::string where = "atmosphere '" + source_name + "'";
+    ResolveSpectra(root, where, nullptr);
+    return ReadTree(root, where);
 }
 
 std::string AtmosphereToJson(const AtmosphereParameters& a) {
@@ -494,8 +756,11 @@ std::vector<std::string> AtmospherePresetNames() {
     return names;
 }
 
-AtmosphereParameters LoadAtmosphere(const std::string& name_or_path,
-                                    const std::vector<std::string>& overrides) {
+namespace {
+
+// The preset's or file's JSON with the overrides applied; `where` names it in errors.
+Json LoadRoot(const std::string& name_or_path, const std::vector<std::string>& overrides,
+              std::string* where_out) {
     std::string text;
     bool found = false;
     for (int i = 0; i < detail::kEmbeddedPresetCount; ++i) {
@@ -537,8 +802,42 @@ AtmosphereParameters LoadAtmosphere(const std::string& name_or_path,
     for (const std::string& override_text : overrides) {
         ApplyOverride(root, override_text, where);
     }
-    if (overrides.empty()) return ReadTree(root, where);
-    return ReadTree(root, where + " (with --set " + Join(overrides, " --set ") + ")");
+    *where_out =
+        overrides.empty() ? where : where + " (with --set " + Join(overrides, " --set ") + ")";
+    return root;
+}
+
+}  // namespace
+
+AtmosphereParameters LoadAtmosphere(const std::string& name_or_path,
+                                    const std::vector<std::string>& overrides) {
+    std::string where;
+    Json root = LoadRoot(name_or_path, overrides, &where);
+    ResolveSpectra(root, where, nullptr);
+    return ReadTree(root, where);
+}
+
+SpectralAtmosphere LoadSpectralAtmosphere(const std::string& name_or_path,
+                                          const std::vector<std::string>& overrides) {
+    std::string where;
+    Json root = LoadRoot(name_or_path, overrides, &where);
+    SpectralAtmosphere spectral;
+    ResolveSpectra(root, where, &spectral);
+    spectral.base = ReadTree(root, where);
+    spectral.name = root.contains("name") && root["name"].is_string()
+                        ? root["name"].get<std::string>()
+                        : name_or_path;
+    if (spectral.spectral) {
+        // Every wavelength of the visible range must give a valid atmosphere.
+        for (int nm = 360; nm <= 830; nm += 10) {
+            try {
+                (void)spectral.AtWavelengths(nm, nm, nm);
+            } catch (const Error& e) {
+                Fail(where, ": at ", nm, " nm: ", e.what());
+            }
+        }
+    }
+    return spectral;
 }
 
 }  // namespace atmos

@@ -6,6 +6,7 @@
 #include <ImfOutputFile.h>
 #include <ImfRgba.h>
 #include <ImfRgbaFile.h>
+#include <ImfStringAttribute.h>
 
 #include <cstdint>
 #include <exception>
@@ -144,6 +145,35 @@ void WriteExr(const Image& image, const std::string& path) {
         Imf::OutputFile file(path.c_str(), header);
         file.setFrameBuffer(frame);
         file.writePixels(image.height());
+    } catch (const Error&) {
+        throw;
+    } catch (const std::exception& e) {
+        Fail("cannot write EXR '", path, "': ", e.what());
+    }
+}
+
+void WriteMultiChannelExr(const std::string& path, int width, int height,
+                          const std::vector<std::string>& names, const std::vector<float>& values,
+                          const std::vector<std::pair<std::string, std::string>>& attributes) {
+    try {
+        Imf::Header header(width, height);
+        header.compression() = Imf::ZIP_COMPRESSION;
+        for (const auto& [name, value] : attributes) {
+            header.insert(name, Imf::StringAttribute(value));
+        }
+        for (const std::string& name : names)
+            header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+        const Imath::Box2i window = header.dataWindow();
+        const size_t x_stride = names.size() * sizeof(float);
+        const size_t y_stride = x_stride * static_cast<size_t>(width);
+        Imf::FrameBuffer frame;
+        for (size_t c = 0; c < names.size(); ++c) {
+            frame.insert(names[c], Imf::Slice::Make(Imf::FLOAT, values.data() + c, window, x_stride,
+                                                    y_stride));
+        }
+        Imf::OutputFile file(path.c_str(), header);
+        file.setFrameBuffer(frame);
+        file.writePixels(height);
     } catch (const Error&) {
         throw;
     } catch (const std::exception& e) {

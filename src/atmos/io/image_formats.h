@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "atmos/image.h"
@@ -18,6 +19,11 @@ namespace atmos::detail {
 // grey, a luminance/chroma file (Y, RY, BY) is converted to RGB.
 void WriteExr(const Image& image, const std::string& path);
 Image ReadExr(const std::string& path);
+// An EXR of `names.size()` float channels, `values` interleaved per pixel (row-major,
+// top row first), with string attributes (name, value).
+void WriteMultiChannelExr(const std::string& path, int width, int height,
+                          const std::vector<std::string>& names, const std::vector<float>& values,
+                          const std::vector<std::pair<std::string, std::string>>& attributes);
 
 // PNG: 8-bit RGB through EncodeDisplayValue(value, exposure). Reads 8- or
 // 16-bit grey, grey+alpha, RGB, RGBA or palette images (alpha is dropped) and

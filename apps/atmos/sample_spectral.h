@@ -1,0 +1,16 @@
+// atmos CLI: the spectral columns of `atmos sample --wavelengths` (sample_spectral.cpp).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "atmos/model.h"
+#include "cli_common.h"
+
+namespace atmos::cli {
+
+// Prints the spectral CSV of `queries` (header L_<nm>..., X, Y, Z) to stdout.
+int SampleSpectralCsv(const CommonOptions& common, const MonteCarloSettings& monte_carlo,
+                      const std::string& wavelengths, const std::vector<SampleQuery>& queries);
+
+}  // namespace atmos::cli
