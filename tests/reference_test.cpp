@@ -777,7 +777,8 @@ TEST(ReferenceHybrid, Order1CachedPerRequestEqualsTheUncachedEstimate) {
                 const Rgb want = ShadePixel(e, setup, x, y);
                 const Rgb got = image.Get(x, y);
                 for (int c = 0; c < 3; ++c) {
-                    EXPECT_NEAR(got[c], want[c], 1e-5 * want[c] + 1e-12) << x << "," << y;
+                    EXPECT_NEAR(got[c], want[c], 1e-5 * static_cast<double>(want[c]) + 1e-12)
+                        << x << "," << y;
                 }
             }
         }
@@ -841,9 +842,10 @@ double ImageMeanSigmas(const Image& fresh, const Image& fresh_var, const Image& 
         double a = 0.0, b = 0.0, var = 0.0;
         for (int y = 0; y < fresh.height(); ++y) {
             for (int x = 0; x < fresh.width(); ++x) {
-                a += fresh.Get(x, y)[c];
-                b += shipped.Get(x, y)[c];
-                var += static_cast<double>(fresh_var.Get(x, y)[c]) + shipped_var.Get(x, y)[c];
+                a += static_cast<double>(fresh.Get(x, y)[c]);
+                b += static_cast<double>(shipped.Get(x, y)[c]);
+                var += static_cast<double>(fresh_var.Get(x, y)[c]) +
+                       static_cast<double>(shipped_var.Get(x, y)[c]);
             }
         }
         const double se = std::sqrt(var) / n;
@@ -899,7 +901,9 @@ TEST(ReferenceShipped, FreshRenderAgreesWithEachShippedImageWithinItsNoise) {
         std::printf("%s: image means %.2f (same atmosphere), %.2f (Rayleigh x 1.1) sigma apart\n",
                     name.c_str(), same, other);
         EXPECT_LE(same, 4.0);
-        if (name == "ground-noon") EXPECT_GT(other, 4.0);
+        if (name == "ground-noon") {
+            EXPECT_GT(other, 4.0);
+        }
     }
 }
 
