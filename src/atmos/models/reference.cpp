@@ -293,6 +293,9 @@ TableView ReferenceModel::Order1Table(const PixelSetup& setup, const ReferenceEv
             }
         }
         order1_key_ = key;
+        // The table the evaluator's copies name (VisitTables uploads it even
+        // when order1_cached is false) must stay the live one.
+        evaluator_.order1_table = order1_table_.view();
     }
     return order1_table_.view();
 }
