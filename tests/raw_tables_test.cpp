@@ -54,6 +54,8 @@ TEST(RawTables, BlobsHoldEveryTableAtItsOffset) {
     const std::string f32 = slurp("tables.f32"), f16 = slurp("tables.f16");
     EXPECT_EQ(j.at("float32").at("bytes").get<size_t>(), f32.size());
     EXPECT_EQ(j.at("float16").at("bytes").get<size_t>(), f16.size());
+    // What compare reports as table memory (Model::TableBytes) without writing.
+    EXPECT_EQ(RawTablesFloat32Bytes({{"a", &a}, {"b", &b}}), f32.size());
     const auto& tb = j.at("tables").at("b");
     EXPECT_EQ(tb.at("width"), 2);
     EXPECT_EQ(tb.at("depth"), 2);

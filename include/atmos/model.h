@@ -159,6 +159,10 @@ class Model {
     // they do not match `atmosphere` or the model's options).
     virtual bool CanBake() const { return false; }
     virtual void Bake(const std::string& directory) const;
+    // The bytes of the tables.f32 that Bake() would write for the last
+    // Prepare() (every table as float32, 256-byte aligned: io/raw_tables.h);
+    // -1 for a model without tables or before Prepare().
+    virtual int64_t TableBytes() const { return -1; }
     virtual void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere);
 };
 

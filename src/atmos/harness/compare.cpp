@@ -27,26 +27,6 @@ double SecondsSince(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// The bytes of a prepared model's tables as float32: the size of the
-// tables.f32 its bake writes (io/raw_tables.h), baked into a scratch folder
-// under `output_dir`; -1 for a model without bakeable tables.
-int64_t TableBytes(const Model& model, const std::string& output_dir) {
-    if (!model.CanBake()) return -1;
-    const fs::path dir = fs::path(output_dir) / ".table-bytes";
-    int64_t bytes = -1;
-    try {
-        fs::remove_all(dir);
-        fs::create_directories(dir);
-        model.Bake(dir.string());
-        bytes = static_cast<int64_t>(fs::file_size(dir / "tables.f32"));
-    } catch (const std::exception&) {
-        bytes = -1;
-    }
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-    return bytes;
-}
-
 // A model's images, rendered on demand: Prepare() runs once, only if some
 // image is not in the cache.
 class LazyRenderer {
@@ -89,7 +69,7 @@ class LazyRenderer {
             model_->Prepare(config_.atmosphere);
             prepare_seconds_ = SecondsSince(start);
             prepared_ = true;
-            table_bytes_ = TableBytes(*model_, config_.output_dir);
+            table_bytes_ = model_->TableBytes();
             cache_.StorePrepare(key_, prepare_seconds_, table_bytes_);
         }
         RenderRequest request;

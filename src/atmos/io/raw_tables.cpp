@@ -68,6 +68,12 @@ void PutLe(std::vector<unsigned char>* out, size_t at, uint32_t v, int bytes) {
 
 }  // namespace
 
+size_t RawTablesFloat32Bytes(const std::vector<RawTable>& tables) {
+    size_t bytes = 0;
+    for (const RawTable& t : tables) bytes = AlignUp(bytes) + 4 * t.table->size();
+    return bytes;
+}
+
 nlohmann::ordered_json WriteRawTables(const std::string& directory,
                                       const std::vector<RawTable>& tables) {
     std::vector<unsigned char> f32, f16;

@@ -26,6 +26,9 @@ struct RawTable {
     const Table* table;
 };
 
+// The size in bytes of the tables.f32 that WriteRawTables writes for `tables`.
+size_t RawTablesFloat32Bytes(const std::vector<RawTable>& tables);
+
 // Writes DIR/tables.f32 and DIR/tables.f16; returns their description (the
 // bake JSON's "raw"). Throws atmos::Error when a file cannot be written.
 nlohmann::ordered_json WriteRawTables(const std::string& directory,

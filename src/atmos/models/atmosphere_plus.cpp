@@ -246,6 +246,18 @@ std::string GlslConstants(const AtmosphereParameters& a, const AplusSettings& s)
 
 }  // namespace
 
+namespace {
+// The tables a bake writes raw (tables.f32/.f16), in their order.
+std::vector<RawTable> RawTables(const AplusTables& tables) {
+    return {{"scattering", &tables.scattering}, {"transmittance", &tables.transmittance}};
+}
+}  // namespace
+
+int64_t AtmospherePlusModel::TableBytes() const {
+    if (tables_.scattering.size() == 0) return -1;
+    return static_cast<int64_t>(RawTablesFloat32Bytes(RawTables(tables_)));
+}
+
 void AtmospherePlusModel::Bake(const std::string& directory) const {
     if (tables_.scattering.size() == 0) Fail("atmosphere-plus: nothing to bake before Prepare()");
     namespace fs = std::filesystem;
@@ -264,10 +276,7 @@ void AtmospherePlusModel::Bake(const std::string& directory) const {
     j["transmittance"] = {{"file", "transmittance.exr"},
                           {"layout", "W x H: altitude (u) x view zenith (v), same mapping"}};
     j["atmosphere"] = nlohmann::json::parse(AtmosphereToJson(atm_));
-    j["raw"] =
-        nlohmann::json::parse(WriteRawTables(directory, {{"scattering", &tables_.scattering},
-                                                         {"transmittance", &tables_.transmittance}})
-                                  .dump());
+    j["raw"] = nlohmann::json::parse(WriteRawTables(directory, RawTables(tables_)).dump());
     j["shaders"] = nlohmann::json::parse(
         WriteGlslConstants(directory, "atmosphere_plus", GlslConstants(atm_, settings_)).dump());
     std::ofstream out(fs::path(directory) / "atmosphere-plus.json");

@@ -375,6 +375,7 @@ class AtmospherePlusModel : public EvaluatorModel<AtmospherePlusModel> {
     // atmosphere-plus.json (sizes, mapping, numerics, the atmosphere).
     bool CanBake() const override { return true; }
     void Bake(const std::string& directory) const override;
+    int64_t TableBytes() const override;
     void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere) override;
 
   private:

@@ -150,6 +150,22 @@ std::string ReadText(const std::string& path) {
 
 }  // namespace
 
+namespace {
+// The tables a bake writes raw (tables.f32/.f16), in their order.
+std::vector<RawTable> RawTables(const BrunetonTables& tables, const BrunetonConfig& config) {
+    std::vector<RawTable> raw = {{"transmittance", &tables.transmittance},
+                                 {"irradiance", &tables.irradiance},
+                                 {"scattering", &tables.scattering}};
+    if (!config.combined_mie) raw.push_back({"single_mie_scattering", &tables.single_mie});
+    return raw;
+}
+}  // namespace
+
+int64_t BrunetonModel::TableBytes() const {
+    if (!prepared_) return -1;
+    return static_cast<int64_t>(RawTablesFloat32Bytes(RawTables(tables_, config_)));
+}
+
 void BrunetonModel::Bake(const std::string& directory) const {
     if (!prepared_) Fail("model bruneton: nothing to bake (Prepare() has not run)");
     namespace fs = std::filesystem;
@@ -213,11 +229,7 @@ void BrunetonModel::Bake(const std::string& directory) const {
                       {"mu_s_min", atm_.mu_s_min},
                       {"texel_centre_mapping", "coord(x, n) = 0.5 / n + x (1 - 1 / n)"}};
     j["atmosphere"] = nlohmann::ordered_json::parse(AtmosphereToJson(atm_));
-    std::vector<RawTable> raw = {{"transmittance", &tables_.transmittance},
-                                 {"irradiance", &tables_.irradiance},
-                                 {"scattering", &tables_.scattering}};
-    if (!config_.combined_mie) raw.push_back({"single_mie_scattering", &tables_.single_mie});
-    j["raw"] = WriteRawTables(directory, raw);
+    j["raw"] = WriteRawTables(directory, RawTables(tables_, config_));
     j["shaders"] = WriteGlslConstants(directory, "bruneton", GlslConstants(atm_, config_));
     const std::string path = (dir / kBakeJson).string();
     std::ofstream out(path);

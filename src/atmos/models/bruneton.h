@@ -783,6 +783,7 @@ class BrunetonModel : public EvaluatorModel<BrunetonModel> {
 
     bool CanBake() const override { return true; }
     void Bake(const std::string& directory) const override;
+    int64_t TableBytes() const override;
     void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere) override;
 
     const BrunetonConfig& config() const { return config_; }

@@ -291,6 +291,19 @@ std::string HillaireGlslConstants(const AtmosphereParameters& a, const HillaireO
 
 }  // namespace
 
+namespace {
+// The tables a bake writes raw (tables.f32/.f16), in their order.
+std::vector<RawTable> RawTables(const Table& transmittance, const Table& multiple_scattering) {
+    return {{"transmittance", &transmittance}, {"multiple_scattering", &multiple_scattering}};
+}
+}  // namespace
+
+int64_t HillaireModel::TableBytes() const {
+    if (!transmittance_.size()) return -1;
+    return static_cast<int64_t>(
+        RawTablesFloat32Bytes(RawTables(transmittance_, multiple_scattering_)));
+}
+
 void HillaireModel::Bake(const std::string& directory) const {
     if (!transmittance_.size()) Fail("model hillaire: nothing to bake (Prepare() was not called)");
     namespace fs = std::filesystem;
@@ -328,9 +341,7 @@ void HillaireModel::Bake(const std::string& directory) const {
            "v likewise"}}});
     j["atmosphere"] = nlohmann::json::parse(AtmosphereToJson(evaluator_.atm));
     j["raw"] = nlohmann::json::parse(
-        WriteRawTables(directory, {{"transmittance", &transmittance_},
-                                   {"multiple_scattering", &multiple_scattering_}})
-            .dump());
+        WriteRawTables(directory, RawTables(transmittance_, multiple_scattering_)).dump());
     j["shaders"] = nlohmann::json::parse(
         WriteGlslConstants(directory, "hillaire", HillaireGlslConstants(evaluator_.atm, options_))
             .dump());

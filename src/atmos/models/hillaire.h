@@ -468,6 +468,7 @@ class HillaireModel : public Model {
     std::vector<SampleAnswer> Sample(const std::vector<SampleQuery>& queries) const override;
     bool CanBake() const override { return true; }
     void Bake(const std::string& directory) const override;
+    int64_t TableBytes() const override;
     void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere) override;
 
     // Per-frame work, exposed for benchmarks: the sky-view table for a camera
