@@ -840,6 +840,9 @@ TEST(ReferenceHybrid, Order1CachedPerRequestEqualsTheUncachedEstimate) {
         model->Render(request, &image);
         ReferenceEvaluator e = static_cast<const ReferenceModel&>(*model).evaluator();
         EXPECT_FALSE(e.order1_cached);  // the model's own evaluator stays uncached
+        // ... and names no order-1 table (only a pass's copy does, holding it
+        // alive), so no later copy of it can name a freed one.
+        EXPECT_EQ(e.order1_table.data, nullptr);
         e.seed = 3;
         e.sample_begin = 0;
         e.sample_count = 8;
