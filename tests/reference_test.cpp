@@ -756,19 +756,18 @@ TEST(ReferenceHybrid, NeeCombAndSunLobeKeepOrderTwo) {
 // `per_batch` paths each), out of 360; *mean_z: the mean over the 360 of the
 // signed differences in combined standard errors (a bias of one sign moves
 // it, however small against each query's own noise).
-int HybridBeyond(const ReferenceOptions& test, const ReferenceOptions& base, int max_order,
-                 int per_batch, double* mean_z) {
-    AtmosphereParameters atm = EarthAtmosphere();
-    atm.ground_albedo = Vec3d(0.3);
-    HybridFixture a_fixture(atm, max_order, test), b_fixture(atm, max_order, base);
+int HybridBeyond(ReferenceEvaluator test, ReferenceEvaluator base, int max_order, int per_batch,
+                 double* mean_z) {
+    test.max_order = base.max_order = max_order;
+    const AtmosphereParameters& atm = test.atm;
     Rng rng(7, 8, 9);
     int beyond = 0, n = 0;
     double z_sum = 0.0;
     for (int q = 0; q < 120; ++q) {
         const Query query = MakeQuery(atm, q, rng);
         Stats a, b;
-        BatchStats(a_fixture.e, query.camera, query.dir, query.sun, q, 20, per_batch, &a);
-        BatchStats(b_fixture.e, query.camera, query.dir, query.sun, q + 1000, 20, per_batch, &b);
+        BatchStats(test, query.camera, query.dir, query.sun, q, 20, per_batch, &a);
+        BatchStats(base, query.camera, query.dir, query.sun, q + 1000, 20, per_batch, &b);
         for (int c = 0; c < 3; ++c) {
             const double se = std::hypot(a.StdError()[c], b.StdError()[c]);
             const double d = a.Mean()[c] - b.Mean()[c];
@@ -792,18 +791,22 @@ TEST(ReferenceHybrid, Order2GuideKeepsTheIntegral) {
     // the Monte Carlo part's, small enough to see a 2 % bias) and, for the
     // resampling (whose weight carries every later order), with all orders.
     // At most 1 % of the 360 channel means beyond 4 combined standard errors.
-    ReferenceOptions base;
+    AtmosphereParameters atm = EarthAtmosphere();
+    atm.ground_albedo = Vec3d(0.3);
+    ReferenceOptions options;
+    const HybridFixture base(atm, 0, options);
+    options.guide = 8;
+    options.guide_everywhere = 1;
+    const HybridFixture guided_fixture(atm, 0, options);  // the tables, built once
     for (const GuideMode mode : {GuideMode::kResample, GuideMode::kControlVariate}) {
-        ReferenceOptions guided = base;
-        guided.guide = 8;
+        ReferenceEvaluator guided = guided_fixture.e;
         guided.guide_mode = mode;
-        guided.guide_everywhere = 1;
         for (const int max_order : {2, 0}) {
             // The control variate's expectation is 0 in order 2 alone.
             if (mode == GuideMode::kControlVariate && max_order == 0) continue;
             double mean_z = 0.0;
             const int beyond =
-                HybridBeyond(guided, base, max_order, max_order == 2 ? 32 : 16, &mean_z);
+                HybridBeyond(guided, base.e, max_order, max_order == 2 ? 32 : 16, &mean_z);
             std::printf(
                 "guide mode %d, max-order %d vs no guide: %d of 360 beyond 4 standard "
                 "errors, mean difference %.3f standard errors\n",
