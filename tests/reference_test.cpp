@@ -494,7 +494,14 @@ struct HybridFixture {
         e.sun_table.tau = table.view();
         e.sun_table.bottom = atm.bottom_radius;
         e.sun_table.top = atm.top_radius;
+        e.guide_candidates = options.guide;
+        e.guide_mode = options.guide_mode;
+        e.guide_everywhere = options.guide_everywhere != 0;
+        if (options.guide > 0) {
+            e.guide_lut = BuildReferenceGuideLut(atm, &guide_transmittance, &guide_scattering);
+        }
     }
+    Table guide_transmittance, guide_scattering;
 };
 
 // Exact (Simpson, `intervals`) sun transmittance, 0 below the horizon.
@@ -744,6 +751,75 @@ TEST(ReferenceHybrid, NeeCombAndSunLobeKeepOrderTwo) {
     }
 }
 
+// Channel means of `test` and `base` (hybrid, max-order `max_order`) beyond
+// 4 combined standard errors over 120 queries as above (20 batches of
+// `per_batch` paths each), out of 360; *mean_z: the mean over the 360 of the
+// signed differences in combined standard errors (a bias of one sign moves
+// it, however small against each query's own noise).
+int HybridBeyond(ReferenceEvaluator test, ReferenceEvaluator base, int max_order, int per_batch,
+                 double* mean_z) {
+    test.max_order = base.max_order = max_order;
+    const AtmosphereParameters& atm = test.atm;
+    Rng rng(7, 8, 9);
+    int beyond = 0, n = 0;
+    double z_sum = 0.0;
+    for (int q = 0; q < 120; ++q) {
+        const Query query = MakeQuery(atm, q, rng);
+        Stats a, b;
+        BatchStats(test, query.camera, query.dir, query.sun, q, 20, per_batch, &a);
+        BatchStats(base, query.camera, query.dir, query.sun, q + 1000, 20, per_batch, &b);
+        for (int c = 0; c < 3; ++c) {
+            const double se = std::hypot(a.StdError()[c], b.StdError()[c]);
+            const double d = a.Mean()[c] - b.Mean()[c];
+            if (std::abs(d) > 4.0 * se + 1e-12) ++beyond;
+            if (se > 0.0) {
+                z_sum += d / se;
+                ++n;
+            }
+        }
+    }
+    *mean_z = n > 0 ? z_sum / n : 0.0;
+    return beyond;
+}
+
+TEST(ReferenceHybrid, Order2GuideKeepsTheIntegral) {
+    // The order-2 guide (a table of single scattering weighting candidate
+    // directions at the first vertex), at every first vertex so that all 120
+    // queries (suns from -12 to 90 degrees) use it: resampled importance
+    // sampling and the control variate against the hybrid estimator without
+    // the guide, at max-order 2 (order 1 identical: the standard errors are
+    // the Monte Carlo part's, small enough to see a 2 % bias) and, for the
+    // resampling (whose weight carries every later order), with all orders.
+    // At most 1 % of the 360 channel means beyond 4 combined standard errors.
+    AtmosphereParameters atm = EarthAtmosphere();
+    atm.ground_albedo = Vec3d(0.3);
+    ReferenceOptions options;
+    const HybridFixture base(atm, 0, options);
+    options.guide = 8;
+    options.guide_everywhere = 1;
+    const HybridFixture guided_fixture(atm, 0, options);  // the tables, built once
+    for (const GuideMode mode : {GuideMode::kResample, GuideMode::kControlVariate}) {
+        ReferenceEvaluator guided = guided_fixture.e;
+        guided.guide_mode = mode;
+        for (const int max_order : {2, 0}) {
+            // The control variate's expectation is 0 in order 2 alone.
+            if (mode == GuideMode::kControlVariate && max_order == 0) continue;
+            double mean_z = 0.0;
+            const int beyond =
+                HybridBeyond(guided, base.e, max_order, max_order == 2 ? 32 : 16, &mean_z);
+            std::printf(
+                "guide mode %d, max-order %d vs no guide: %d of 360 beyond 4 standard "
+                "errors, mean difference %.3f standard errors\n",
+                static_cast<int>(mode), max_order, beyond, mean_z);
+            EXPECT_LE(beyond, 3) << static_cast<int>(mode) << " " << max_order;
+            // The mean of 360 differences in standard errors: about N(0, 1/360)
+            // without bias, N(0, 1/120) if a query's three channels moved together.
+            EXPECT_LE(std::abs(mean_z), 4.0 / std::sqrt(120.0))
+                << static_cast<int>(mode) << " " << max_order;
+        }
+    }
+}
+
 TEST(ReferenceHybrid, Order1CachedPerRequestEqualsTheUncachedEstimate) {
     // A render computes order 1 once per request (pixel setup) and reuses it
     // in every pass: renders of one view, another, then the first again
@@ -767,6 +843,9 @@ TEST(ReferenceHybrid, Order1CachedPerRequestEqualsTheUncachedEstimate) {
         model->Render(request, &image);
         ReferenceEvaluator e = static_cast<const ReferenceModel&>(*model).evaluator();
         EXPECT_FALSE(e.order1_cached);  // the model's own evaluator stays uncached
+        // ... and names no order-1 table (only a pass's copy does, holding it
+        // alive), so no later copy of it can name a freed one.
+        EXPECT_EQ(e.order1_table.data, nullptr);
         e.seed = 3;
         e.sample_begin = 0;
         e.sample_count = 8;

@@ -3,11 +3,13 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "atmos/error.h"
 #include "base/parallel.h"
+#include "models/bruneton_stages.h"
 
 namespace atmos {
 
@@ -106,6 +108,36 @@ Table BuildSunOpticalDepthTable(const AtmosphereParameters& atm, int mu_size, in
     return table;
 }
 
+BrunetonLut BuildReferenceGuideLut(const AtmosphereParameters& atm, Table* transmittance,
+                                   Table* scattering) {
+    BrunetonConfig config;  // seed 004's sizes
+    config.combined_mie = true;
+    config.scattering_samples = 50;  // seed 004's count (a guide needs no more)
+    BrunetonLut lut(atm, config);
+    transmittance->Resize(config.transmittance_width, config.transmittance_height, 1, 3);
+    const BrunetonTransmittanceStage stage{BrunetonMappingsOnly(lut), transmittance->out()};
+    ParallelFor(static_cast<int64_t>(config.transmittance_width) * config.transmittance_height, 64,
+                [&](int64_t item) { stage(item); });
+    lut.transmittance_table = transmittance->view();
+    Table rayleigh, mie;
+    ComputeBrunetonSingleScatteringRows(lut, &rayleigh, &mie);
+    scattering->Resize(rayleigh.width(), rayleigh.height(), rayleigh.depth(), 4);
+    for (int z = 0; z < rayleigh.depth(); ++z) {
+        for (int y = 0; y < rayleigh.height(); ++y) {
+            for (int x = 0; x < rayleigh.width(); ++x) {
+                float* out = scattering->Texel(x, y, z);
+                const float* r = rayleigh.Texel(x, y, z);
+                out[0] = r[0];
+                out[1] = r[1];
+                out[2] = r[2];
+                out[3] = mie.Texel(x, y, z)[0];
+            }
+        }
+    }
+    lut.scattering_table = scattering->view();
+    return lut;
+}
+
 ModelInfo ReferenceModel::StaticInfo() {
     ModelInfo info;
     info.name = "reference";
@@ -156,7 +188,19 @@ const OptionTable<ReferenceOptions>& ReferenceModel::OptionRows() {
                   "Henyey-Greenstein lobe around the sun at a first vertex with the sun below "
                   "its horizon (twilight; MIS with the phase function; 0: none)")
             .Real("sun-lobe-g", &O::sun_lobe_g, 0.0, 0.99, "",
-                  "hybrid: the sun lobe's Henyey-Greenstein g");
+                  "hybrid: the sun lobe's Henyey-Greenstein g")
+            .Integer("guide", &O::guide, 0, kMaxGuideCandidates, "",
+                     "hybrid: candidate directions per first vertex of the order-2 guide, a "
+                     "table of single scattering (seed 004's) that weights them (0: off)")
+            .Choice("guide-mode", &O::guide_mode,
+                    {{"resample", GuideMode::kResample}, {"cv", GuideMode::kControlVariate}},
+                    "hybrid: resample: the first continuation direction by resampled importance "
+                    "sampling of the candidates (unbiased); cv: the table's order 2 from the "
+                    "candidates as a control variate, Monte Carlo on the difference (unbiased; "
+                    "its samples can be negative)")
+            .Integer("guide-everywhere", &O::guide_everywhere, 0, 1, "",
+                     "hybrid: 1: the guide at every first vertex; 0: only where the sun is below "
+                     "the vertex's horizon (twilight)");
     return table;
 }
 
@@ -175,6 +219,9 @@ ReferenceModel::ReferenceModel(const ReferenceOptions& options) : info_(StaticIn
     evaluator_.nee_comb = options.nee_comb;
     evaluator_.sun_lobe = options.sun_lobe;
     evaluator_.sun_lobe_g = options.sun_lobe_g;
+    evaluator_.guide_candidates = hybrid ? options.guide : 0;
+    evaluator_.guide_mode = options.guide_mode;
+    evaluator_.guide_everywhere = options.guide_everywhere != 0;
     sun_disc_light_ = options.sun_disc_light != 0;
     Prepare(EarthAtmosphere());
 }
@@ -190,10 +237,18 @@ void ReferenceModel::Prepare(const AtmosphereParameters& atmosphere) {
     evaluator_.sun_table.tau = sun_table_.view();
     evaluator_.sun_table.bottom = atmosphere.bottom_radius;
     evaluator_.sun_table.top = atmosphere.top_radius;
-    order1_table_ = Table(1, 1, 1, 3);  // until a render computes it
+    // The model's evaluator never names an order-1 table (only a pass's copy
+    // does, holding the table alive: Order1Table), so no copy of it can name
+    // a freed one.
+    order1_table_.reset();
     order1_key_.clear();
-    evaluator_.order1_table = order1_table_.view();
+    evaluator_.order1_table = TableView();
     evaluator_.order1_cached = false;
+    // Built on first use with the guide on (evaluator()); no table until then
+    // (a null view is not copied to a device).
+    guide_transmittance_ = Table();
+    guide_scattering_ = Table();
+    evaluator_.guide_lut = BrunetonLut();
 }
 
 const ReferenceEvaluator& ReferenceModel::evaluator() const {
@@ -202,6 +257,10 @@ const ReferenceEvaluator& ReferenceModel::evaluator() const {
         sun_table_ = BuildSunOpticalDepthTable(evaluator_.atm, kSunTableMuSize, kSunTableRSize,
                                                kSunTableIntervals);
         evaluator_.sun_table.tau = sun_table_.view();
+        if (evaluator_.guide_candidates > 0) {
+            evaluator_.guide_lut =
+                BuildReferenceGuideLut(evaluator_.atm, &guide_transmittance_, &guide_scattering_);
+        }
     }
     sun_table_ready_ = true;
     return evaluator_;
@@ -218,6 +277,10 @@ std::string ReferenceModel::PassKey() const {
         key["nee_comb"] = evaluator_.nee_comb;
         key["sun_lobe"] = {evaluator_.sun_lobe, evaluator_.sun_lobe_g};
         key["sun_table"] = {kSunTableMuSize, kSunTableRSize, kSunTableIntervals};
+        if (evaluator_.guide_candidates > 0) {
+            key["guide"] = {evaluator_.guide_candidates, static_cast<int>(evaluator_.guide_mode),
+                            evaluator_.guide_everywhere};
+        }
     }
     key["sun_cone_cos"] = evaluator_.sun_cone_cos;
     key["shells"] = evaluator_.shells.count;
@@ -241,16 +304,19 @@ void ReferenceModel::RenderPass(const RenderRequest& request, const MonteCarloPa
     }
     // The sun table (and order 1) stay on the device from pass to pass.
     ResidentScope scope(&resident_);
+    std::shared_ptr<const Table> order1;  // alive for the pass, whatever later requests do
     if (request.quantity != Quantity::kTransmittance &&
         e.estimator == ReferenceEstimator::kHybrid) {
-        e.order1_table = Order1Table(setup, e);
+        order1 = Order1Table(setup, e);
+        e.order1_table = order1->view();
         e.order1_cached = true;
     }
     scope.Keep(e);
     RenderImage(e, setup, out->View(), progress);
 }
 
-TableView ReferenceModel::Order1Table(const PixelSetup& setup, const ReferenceEvaluator& e) const {
+std::shared_ptr<const Table> ReferenceModel::Order1Table(const PixelSetup& setup,
+                                                         const ReferenceEvaluator& e) const {
     // Deterministic work, the same in every pass: once per request.
     const Camera& c = setup.camera;
     std::vector<double> key = {c.position.x,
@@ -272,7 +338,7 @@ TableView ReferenceModel::Order1Table(const PixelSetup& setup, const ReferenceEv
                                static_cast<double>(setup.width),
                                static_cast<double>(setup.height)};
     std::lock_guard<std::mutex> lock(sun_table_mutex_);
-    if (key != order1_key_) {
+    if (!order1_table_ || key != order1_key_) {
         ReferenceEvaluator first = e;
         first.max_order = 1;
         first.sample_begin = 0;
@@ -284,20 +350,19 @@ TableView ReferenceModel::Order1Table(const PixelSetup& setup, const ReferenceEv
         Image image;
         image.Resize(setup.width, setup.height);
         RenderImage(first, unit, image.View(), nullptr);
-        order1_table_ = Table(setup.width, setup.height, 1, 3);
+        auto table = std::make_shared<Table>(setup.width, setup.height, 1, 3);
         for (int y = 0; y < setup.height; ++y) {
             for (int x = 0; x < setup.width; ++x) {
                 const Rgb v = image.Get(x, y);
-                float* texel = order1_table_.Texel(x, y);
+                float* texel = table->Texel(x, y);
                 for (int ch = 0; ch < 3; ++ch) texel[ch] = v[ch];
             }
         }
+        // A pass still rendering with the previous table keeps it alive.
+        order1_table_ = std::move(table);
         order1_key_ = key;
-        // The table the evaluator's copies name (VisitTables uploads it even
-        // when order1_cached is false) must stay the live one.
-        evaluator_.order1_table = order1_table_.view();
     }
-    return order1_table_.view();
+    return order1_table_;
 }
 
 std::vector<SampleAnswer> ReferenceModel::SamplePass(const std::vector<SampleQuery>& queries,

@@ -55,6 +55,7 @@
 
 #include <stdint.h>
 
+#include <memory>
 #include <mutex>
 #include <vector>
 
@@ -62,6 +63,7 @@
 #include "atmos/model.h"
 #include "base/rng.h"
 #include "base/texture.h"
+#include "models/bruneton.h"
 #include "models/evaluator_model.h"
 #include "physics/density.h"
 #include "physics/geometry.h"
@@ -147,6 +149,20 @@ constexpr int kHybridViewIntervals = 96;
 constexpr int kHybridMaxNodes = 128;
 // The most next-event comb points per continuation segment.
 constexpr int kMaxNeeComb = 8;
+// The most candidate directions of the order-2 guide per first vertex.
+constexpr int kMaxGuideCandidates = 64;
+// The order-2 guide's modes (option `guide-mode`).
+enum class GuideMode : int {
+    // Resampled importance sampling of the first continuation direction.
+    kResample = 0,
+    // A control variate: the table's order 2 estimated from the candidates,
+    // Monte Carlo on the difference only.
+    kControlVariate = 1,
+};
+// The guide's defensive share: the resampling target is f (C + kGuideDefensive
+// mean C), so a direction the table misses keeps a pdf >= 1/(1 + 1/0.1) of
+// the phase function's, relative to the candidates' mean.
+constexpr double kGuideDefensive = 0.1;
 
 struct ReferenceEvaluator {
     static constexpr bool kStochastic = true;
@@ -179,6 +195,15 @@ struct ReferenceEvaluator {
     int nee_comb = 0;
     double sun_lobe = 0.0;
     double sun_lobe_g = 0.8;
+    // kHybrid: the order-2 guide (0: off): `guide_candidates` directions per
+    // first vertex, weighted by a table of single scattering (guide_lut:
+    // seed 004's single-scattering table, combined storage, built by
+    // BuildReferenceGuideLut), at first vertices with the sun below their
+    // horizon (or everywhere: guide_everywhere). See SampleGuidedDirection.
+    int guide_candidates = 0;
+    GuideMode guide_mode = GuideMode::kResample;
+    bool guide_everywhere = false;
+    BrunetonLut guide_lut;
 
     // kHybrid renders: order 1 of every pixel (sky + ground, per unit
     // irradiance; width x height x 3, texel (key % width, key / width)),
@@ -191,6 +216,8 @@ struct ReferenceEvaluator {
     void VisitTables(V& v) {
         v(sun_table.tau);
         v(order1_table);
+        v(guide_lut.transmittance_table);
+        v(guide_lut.scattering_table);
     }
 
     // 1: the sun is a point (directional light, as the other models); < 1: the
@@ -871,6 +898,100 @@ struct ReferenceEvaluator {
         return next;
     }
 
+    // The guide's single-scattered radiance C arriving at x from direction
+    // omega (the light a ray from x along omega gathers by one scattering,
+    // per unit irradiance; the volume only): seed 004's table lookup with
+    // both phase functions. Any C keeps the guided estimators unbiased; the
+    // closer to the true order 1 along omega, the lower their variance.
+    ATMOS_HD Vec3d GuideRadiance(const Vec3d& x, const Vec3d& omega, const Vec3d& sun) const {
+        const double r = Length(x);
+        const double mu = ClampCosine(Dot(x, omega) / r);
+        const double nu = ClampCosine(Dot(omega, sun));
+        Rgb mie;
+        const Rgb rayleigh =
+            guide_lut.CombinedScattering(r, mu, ClampCosine(Dot(x, sun) / r), nu,
+                                         RayIntersectsGround(r, mu, atm.bottom_radius), &mie);
+        return Vec3d(rayleigh) * RayleighPhase(nu) +
+               Vec3d(mie) * CornetteShanksPhase(atm.mie_phase_g, nu);
+    }
+
+    ATMOS_HD bool GuideApplies(const Vec3d& x, const Vec3d& sun) const {
+        return guide_candidates > 0 && (guide_everywhere || Dot(x, sun) < 0.0);
+    }
+
+    // The order-2 guide at a first vertex x (event chosen, throughput *w;
+    // f the event's phase function about dir). Candidates: n directions
+    // omega_i drawn from f (Rayleigh exactly, Mie by Henyey-Greenstein,
+    // ratio r_i = f / pdf), stratified (a rank-1 lattice in the two uniform
+    // numbers with a random shift, so each is marginally distributed by the
+    // pdf); c_i = mean_c(w_c C_c(x, omega_i)).
+    //
+    // kResample (resampled importance sampling, Talbot et al. 2005): the
+    // returned direction is candidate j with probability ~ q_j = r_j (c_j +
+    // delta) (delta = kGuideDefensive mean_i r_i c_i), weighted by
+    // f / phat (omega_j) mean_i q_i = mean_i q_i / (c_j + delta), phat = f (c +
+    // delta). Given the candidates the expected estimate is the mean of the
+    // n phase-sampled estimates (1/n) sum_i r_i F(omega_i) whatever phat is
+    // (phat > 0), so the estimator is unbiased for every continuation F;
+    // it favours the directions where the table says order 2 comes from.
+    //
+    // kControlVariate: the returned direction is drawn as without the guide
+    // (SampleFirstDirection, independent of the candidates); *cv gets
+    // w (1/n) sum_i r_i C(omega_i) - w' C(omega) (w' the direction's weight):
+    // its expectation is 0, so adding it to the path's estimate keeps the
+    // mean and removes most of order 2's variance where C tracks it. Its
+    // samples can be negative.
+    ATMOS_HD Vec3d SampleGuidedDirection(const Vec3d& x, const Vec3d& dir, bool rayleigh,
+                                         const Vec3d& sun, Rng& rng, Vec3d* w, Vec3d* cv) const {
+        const int n = Min(guide_candidates, kMaxGuideCandidates);
+        const double g = atm.mie_phase_g;
+        const double xi1 = rng.Uniform(), xi2 = rng.Uniform();
+        const bool resample = guide_mode == GuideMode::kResample;
+        Vec3d cand[kMaxGuideCandidates];
+        double q[kMaxGuideCandidates];
+        double mean_c = 0.0;
+        Vec3d mean_cv;
+        for (int i = 0; i < n; ++i) {
+            const double u1 = (i + xi1) / n;
+            double u2 = xi2 + 0.6180339887498949 * i;
+            u2 -= floor(u2);
+            const double mu =
+                rayleigh ? SampleRayleighCosine(u1) : SampleHenyeyGreensteinCosine(g, u1);
+            const double ratio = rayleigh ? 1.0 : CornetteShanksOverHenyeyGreenstein(g, mu);
+            cand[i] = MakeDirection(dir, mu, u2);
+            const Vec3d c = GuideRadiance(x, cand[i], sun);
+            if (resample) {
+                q[i] = ratio * Dot(*w, c) * (1.0 / 3.0);
+                mean_c += q[i];
+            } else {
+                mean_cv += c * ratio;
+            }
+        }
+        if (!resample) {
+            const Vec3d w_before = *w;
+            const Vec3d next = SampleFirstDirection(x, dir, rayleigh, sun, rng, w);
+            *cv = w_before * mean_cv * (1.0 / n) - *w * GuideRadiance(x, next, sun);
+            return next;
+        }
+        mean_c /= n;
+        const double delta = mean_c > 0.0 ? kGuideDefensive * mean_c : 1.0;
+        double total = 0.0;
+        for (int i = 0; i < n; ++i) {
+            const double mu = Dot(cand[i], dir);
+            const double ratio = rayleigh ? 1.0 : CornetteShanksOverHenyeyGreenstein(g, mu);
+            q[i] += ratio * delta;
+            total += q[i];
+        }
+        double pick = rng.Uniform() * total;
+        int j = 0;
+        while (j + 1 < n && pick >= q[j]) pick -= q[j++];
+        const double ratio_j =
+            rayleigh ? 1.0 : CornetteShanksOverHenyeyGreenstein(g, Dot(cand[j], dir));
+        // f / phat mean_i q_i = ratio_j mean_i q_i / q_j.
+        *w = *w * (ratio_j * (total / n) / q[j]);
+        return cand[j];
+    }
+
     ATMOS_HD Vec3d SamplePhaseDirection(const Vec3d& dir, bool rayleigh, Rng& rng, Vec3d* w) const {
         if (rayleigh) {
             return MakeDirection(dir, SampleRayleighCosine(rng.Uniform()), rng.Uniform());
@@ -966,7 +1087,11 @@ struct ReferenceEvaluator {
             const bool rayleigh = rng.Uniform() * (a_r + a_m) < a_r;
             Vec3d w =
                 w0 * (rayleigh ? sigma_r * ((a_r + a_m) / a_r) : sigma_m * ((a_r + a_m) / a_m));
-            const Vec3d next = SampleFirstDirection(x, dir, rayleigh, sun, rng, &w);
+            Vec3d cv;
+            const Vec3d next = GuideApplies(x, sun)
+                                   ? SampleGuidedDirection(x, dir, rayleigh, sun, rng, &w, &cv)
+                                   : SampleFirstDirection(x, dir, rayleigh, sun, rng, &w);
+            *sky += cv;
             HybridContinue(x, next, w, 1, sun, rng, sky);
         }
     }
@@ -1038,7 +1163,17 @@ struct ReferenceOptions {
     int nee_comb = 2;             // hybrid: comb points per continuation segment (twilight)
     double sun_lobe = 0.5;        // hybrid: the first direction's sun-lobe probability (twilight)
     double sun_lobe_g = 0.8;      // hybrid: its Henyey-Greenstein g
+    int guide = 0;                // hybrid: the order-2 guide's candidates (0: off)
+    GuideMode guide_mode = GuideMode::kResample;
+    int guide_everywhere = 0;  // 1: at every first vertex, 0: twilight ones only
 };
+
+// The order-2 guide's table (ReferenceEvaluator::GuideRadiance): seed 004's
+// transmittance and single-scattering tables (Rayleigh RGB and Mie red,
+// combined storage) for `atm`, built on the CPU into the two tables; the
+// returned lookup names them.
+BrunetonLut BuildReferenceGuideLut(const AtmosphereParameters& atm, Table* transmittance,
+                                   Table* scattering);
 
 // The sun's optical-depth table of the hybrid estimator: texels along x_mu and
 // x_r, and the Simpson intervals per texel (error bound: reference_test.cpp).
@@ -1066,7 +1201,9 @@ class ReferenceModel : public MonteCarloModel {
   private:
     // The order-1 image of a radiance render's pixel setup (computed on its
     // first pass, a deterministic launch of max-order 1).
-    TableView Order1Table(const PixelSetup& setup, const ReferenceEvaluator& e) const;
+    // Shared: the cache and every pass using it hold it.
+    std::shared_ptr<const Table> Order1Table(const PixelSetup& setup,
+                                             const ReferenceEvaluator& e) const;
 
     ModelInfo info_;
     mutable ReferenceEvaluator evaluator_;
@@ -1076,8 +1213,10 @@ class ReferenceModel : public MonteCarloModel {
     mutable ResidentTables resident_;  // the sun table's device copy (render/stages.h)
     // The hybrid estimator's order-1 image of the last radiance request (its
     // pixel setup's numbers as the key), reused by every pass of a render.
-    mutable Table order1_table_;
+    mutable std::shared_ptr<const Table> order1_table_;
     mutable std::vector<double> order1_key_;
+    // The order-2 guide's tables (built on first use when the guide is on).
+    mutable Table guide_transmittance_, guide_scattering_;
     int shell_count_ = 48;
     bool sun_disc_light_ = false;
 };
