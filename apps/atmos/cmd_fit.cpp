@@ -112,8 +112,17 @@ Command AddFitCommand(CLI::App* root) {
         ->capture_default_str();
     c.app
         ->add_option("--network", o->fit.network,
-                     "thesis (4-8-8-3 scattering) or large (7-32-32-3, extended inputs)")
+                     "thesis (4-8-8-3 scattering) or large (8-32-32-3, horizon inputs)")
         ->capture_default_str();
+    c.app->add_option("--encoding", o->fit.encoding,
+                      "scattering inputs: thesis | extended | horizon (default: the network's "
+                      "own; large: horizon, extended: before issue 15)");
+    c.app->add_option("--horizon-fraction", o->fit.horizon_fraction,
+                      "fraction of scattering samples viewing near the horizon (default: thesis "
+                      "0, large 0.25)");
+    c.app->add_option("--loss-epsilon", o->fit.loss_epsilon,
+                      "eps of the scattering loss ln((y_hat + eps) / (y + eps)) (default: "
+                      "thesis 1e-4, large 1e-7)");
     c.app->add_option("--transmittance-samples", o->fit.transmittance_samples)
         ->capture_default_str();
     c.app->add_option("--scattering-samples", o->fit.scattering_samples)->capture_default_str();

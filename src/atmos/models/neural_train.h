@@ -8,9 +8,10 @@
 // contract): transmittance of rays that reach the top of the atmosphere
 // (mu above the horizon; the model reverses rays that look down, seed 003
 // section 9.6.3), and sky radiance per unit irradiance for rays to their end.
-// Loss: mean squared difference of ln(y + eps), eps = 1e-4 (a relative error,
-// so that twilight and the zenith count alike). Training is single-threaded
-// and uses the counter-based Rng only, so it is deterministic for a seed.
+// Loss: mean squared difference of ln(y + eps) (a relative error, so that
+// twilight and the zenith count alike); eps = 1e-4 for the transmittance and
+// the thesis network, 1e-7 for the large one (NeuralFitOptions::loss_epsilon). Training is
+// single-threaded and uses the counter-based Rng only, so it is deterministic for a seed.
 //
 // The networks are small (at most ~1400 weights), so the multilayer
 // perceptron, its backpropagation and Adam are written out here (clear loops in
@@ -28,7 +29,23 @@
 namespace atmos {
 
 struct NeuralFitOptions {
-    std::string network = "thesis";  // thesis: 4-8-8-3; large: 7-32-32-3, extended inputs
+    std::string network = "thesis";  // thesis: 4-8-8-3; large: 8-32-32-3, horizon inputs
+    // Input encoding of the scattering network (models/neural_net.h): empty =
+    // the network's own (thesis: thesis; large: horizon); "extended" is the
+    // large network's encoding before issue 15. The thesis network takes only
+    // "thesis".
+    std::string encoding;
+    // Fraction of the scattering samples whose view direction is drawn near
+    // the horizon (mu = mu_horizon(h) +- 0.15 v^2, v uniform; issue 15);
+    // negative = the network's own (thesis: 0, the thesis's uniform mu;
+    // large: 0.25).
+    double horizon_fraction = -1.0;
+    // eps of the scattering network's loss, squared ln((y_hat + eps) / (y + eps)):
+    // values well below eps hardly count. Negative = the network's own
+    // (thesis: 1e-4, as before; large: 1e-7, issue 15: at 1e-4 the radiance of
+    // rays high in the atmosphere, ~1e-6 per unit irradiance, was not fitted:
+    // horizontal rays at 99 km came out 3-4x too bright).
+    double loss_epsilon = -1.0;
     int transmittance_samples = 4096;
     int scattering_samples = 16384;
     int transmittance_steps = 3000;
