@@ -122,7 +122,7 @@ Command AddFitCommand(CLI::App* root) {
                       "0, large 0.25)");
     c.app->add_option("--loss-epsilon", o->fit.loss_epsilon,
                       "eps of the scattering loss ln((y_hat + eps) / (y + eps)) (default: "
-                      "thesis 1e-4, large 1e-7)");
+                      "thesis 1e-4, large 1e-6)");
     c.app->add_option("--transmittance-samples", o->fit.transmittance_samples)
         ->capture_default_str();
     c.app->add_option("--scattering-samples", o->fit.scattering_samples)->capture_default_str();
@@ -139,8 +139,8 @@ Command AddFitCommand(CLI::App* root) {
         ->capture_default_str();
     c.app
         ->add_option("--final-learning-rate", o->fit.final_learning_rate,
-                     "step size at the last step (exponential decay; equal to --learning-rate: "
-                     "constant, as the thesis)")
+                     "the scattering network's step size at its last iteration (exponential "
+                     "decay; equal to --learning-rate: constant, as the thesis)")
         ->capture_default_str();
     c.app->add_option("--holdout", o->fit.holdout, "fraction of samples held out")
         ->capture_default_str();

@@ -10,7 +10,7 @@
 // section 9.6.3), and sky radiance per unit irradiance for rays to their end.
 // Loss: mean squared difference of ln(y + eps) (a relative error, so that
 // twilight and the zenith count alike); eps = 1e-4 for the transmittance and
-// the thesis network, 1e-7 for the large one (NeuralFitOptions::loss_epsilon). Training is
+// the thesis network, 1e-6 for the large one (NeuralFitOptions::loss_epsilon). Training is
 // single-threaded and uses the counter-based Rng only, so it is deterministic for a seed.
 //
 // The networks are small (at most ~1400 weights), so the multilayer
@@ -42,9 +42,10 @@ struct NeuralFitOptions {
     double horizon_fraction = -1.0;
     // eps of the scattering network's loss, squared ln((y_hat + eps) / (y + eps)):
     // values well below eps hardly count. Negative = the network's own
-    // (thesis: 1e-4, as before; large: 1e-7, issue 15: at 1e-4 the radiance of
+    // (thesis: 1e-4, as before; large: 1e-6, issue 15: at 1e-4 the radiance of
     // rays high in the atmosphere, ~1e-6 per unit irradiance, was not fitted:
-    // horizontal rays at 99 km came out 3-4x too bright).
+    // horizontal rays at 99 km came out 3-4x too bright; 1e-7 and 3e-7 fitted
+    // them better and the rest of the sky worse, docs/models/neural.md).
     double loss_epsilon = -1.0;
     int transmittance_samples = 4096;
     int scattering_samples = 16384;
@@ -53,7 +54,9 @@ struct NeuralFitOptions {
     int batch = 128;
     double learning_rate = 0.01;  // seed 003 section 9.6
     // Beyond the thesis: the step size decays exponentially from
-    // learning_rate to final_learning_rate over the steps (equal: constant).
+    // learning_rate to final_learning_rate over the steps (equal: constant);
+    // the scattering network's only (the transmittance network keeps
+    // learning_rate).
     double final_learning_rate = 0.01;
     double holdout = 0.1;  // fraction of samples held out
     uint64_t seed = 1;
