@@ -37,7 +37,8 @@ int CmdFit(const FitOptions& o) {
     if (o.model != "neural") Fail("fit: only --model neural can be fitted, got '", o.model, "'");
     if (o.reference == o.model) Fail("fit: --reference cannot be the model being fitted");
     if (o.output.empty()) Fail("fit: -o FILE.json is required");
-    CheckOutputFile(o.output);  // before the fit (io/output_path.h)
+    CheckOutputFile(o.output);     // before the fit (io/output_path.h)
+    CheckNeuralFitOptions(o.fit);  // before the reference's precomputation
     ThreadLimit limit(o.threads);
     const AtmosphereParameters atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
     const ModelSpec spec = ParseModelSpec(o.reference);

@@ -255,8 +255,7 @@ NeuralNetFitReport FitOne(Mlp* net, const DataSet& all, int steps, double final_
 
 }  // namespace
 
-NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
-                        const NeuralFitOptions& o, NeuralFitReport* report) {
+NeuralFitChoices CheckNeuralFitOptions(const NeuralFitOptions& o) {
     if (o.network != "thesis" && o.network != "large") {
         Fail("fit: --network must be thesis or large, got '", o.network, "'");
     }
@@ -269,7 +268,9 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     }
     if (!(o.holdout >= 0.0 && o.holdout < 0.9)) Fail("fit: holdout must be in [0, 0.9)");
     const bool large = o.network == "large";
-    NeuralEncoding enc = large ? NeuralEncoding::kHorizon : NeuralEncoding::kThesis;
+    NeuralFitChoices c;
+    NeuralEncoding& enc = c.encoding;
+    enc = large ? NeuralEncoding::kHorizon : NeuralEncoding::kThesis;
     if (o.encoding == "extended" || o.encoding == "horizon") {
         if (!large) Fail("fit: --encoding ", o.encoding, " needs --network large");
         enc = o.encoding == "extended" ? NeuralEncoding::kExtended : NeuralEncoding::kHorizon;
@@ -278,13 +279,24 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     } else if (o.encoding == "thesis" && large) {
         Fail("fit: --encoding thesis needs --network thesis");
     }
-    const double horizon_fraction =
-        o.horizon_fraction >= 0.0 ? o.horizon_fraction : (large ? 0.25 : 0.0);
+    double& horizon_fraction = c.horizon_fraction;
+    horizon_fraction = o.horizon_fraction >= 0.0 ? o.horizon_fraction : (large ? 0.25 : 0.0);
     if (!(horizon_fraction <= 1.0)) Fail("fit: --horizon-fraction must be in [0, 1]");
-    const double loss_epsilon = o.loss_epsilon >= 0.0 ? o.loss_epsilon : (large ? 1e-6 : 1e-4);
+    double& loss_epsilon = c.loss_epsilon;
+    loss_epsilon = o.loss_epsilon >= 0.0 ? o.loss_epsilon : (large ? 1e-6 : 1e-4);
     if (!(loss_epsilon > 0.0 && loss_epsilon <= 1.0)) {
         Fail("fit: --loss-epsilon must be in (0, 1]");
     }
+    return c;
+}
+
+NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
+                        const NeuralFitOptions& o, NeuralFitReport* report) {
+    const NeuralFitChoices choices = CheckNeuralFitOptions(o);
+    const bool large = o.network == "large";
+    const NeuralEncoding enc = choices.encoding;
+    const double horizon_fraction = choices.horizon_fraction;
+    const double loss_epsilon = choices.loss_epsilon;
     const double thickness = atm.top_radius - atm.bottom_radius;
     const auto t0 = std::chrono::steady_clock::now();
 

@@ -78,6 +78,17 @@ struct NeuralFitReport {
     double train_seconds = 0.0;
 };
 
+// What the options resolve to (the network's own encoding, horizon fraction
+// and loss eps where not given).
+struct NeuralFitChoices {
+    NeuralEncoding encoding = NeuralEncoding::kThesis;
+    double horizon_fraction = 0.0;
+    double loss_epsilon = 1e-4;
+};
+// Throws atmos::Error naming the first bad option (FitNeural calls it; the CLI
+// too, before the reference's precomputation).
+NeuralFitChoices CheckNeuralFitOptions(const NeuralFitOptions& options);
+
 // Samples `reference` (already prepared for `atmosphere`) and fits both networks.
 NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atmosphere,
                         const NeuralFitOptions& options, NeuralFitReport* report);
