@@ -1,6 +1,6 @@
 // atmos micro-benchmark of the `neural` model: nanoseconds per evaluator call
 // (one view ray) for the thesis-size network (4-8-8-3) and the large one
-// (7-32-32-3), from the ground at sunrise and from orbit, through the evaluator
+// (8-32-32-3), from the ground at sunrise and from orbit, through the evaluator
 // directly (no render loop). `bruneton` beside them for scale.
 //
 // Run: build/bench/atmos_bench --benchmark_filter=Neural

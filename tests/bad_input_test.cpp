@@ -113,6 +113,12 @@ TEST(BadInput, EveryCommandGivesOneLineAndExitTwo) {
         {"compare --models preetham --quantity transmittance -o " + d + "/cmp",
          "does not produce transmittance"},
         {"fit --model neural --reference preetham -o " + d + "/w.json", "cannot be a reference"},
+        // Fit options, checked before the reference's precomputation (issue 15).
+        {"fit --model neural --encoding nope -o " + d + "/w.json", "--encoding"},
+        {"fit --model neural --encoding horizon -o " + d + "/w.json", "needs --network large"},
+        {"fit --model neural --network large --loss-epsilon 0 -o " + d + "/w.json",
+         "--loss-epsilon"},
+        {"fit --model neural --horizon-fraction 2 -o " + d + "/w.json", "--horizon-fraction"},
         {"render --quantity colour --size 8x4" + out, "unknown quantity"},
         // Models and their options: NaN, infinity, hexadecimal, out of range, wrong type.
         {"render --model nope --size 8x4" + out, "unknown model 'nope'"},

@@ -37,7 +37,8 @@ int CmdFit(const FitOptions& o) {
     if (o.model != "neural") Fail("fit: only --model neural can be fitted, got '", o.model, "'");
     if (o.reference == o.model) Fail("fit: --reference cannot be the model being fitted");
     if (o.output.empty()) Fail("fit: -o FILE.json is required");
-    CheckOutputFile(o.output);  // before the fit (io/output_path.h)
+    CheckOutputFile(o.output);     // before the fit (io/output_path.h)
+    CheckNeuralFitOptions(o.fit);  // before the reference's precomputation
     ThreadLimit limit(o.threads);
     const AtmosphereParameters atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
     const ModelSpec spec = ParseModelSpec(o.reference);
@@ -112,8 +113,17 @@ Command AddFitCommand(CLI::App* root) {
         ->capture_default_str();
     c.app
         ->add_option("--network", o->fit.network,
-                     "thesis (4-8-8-3 scattering) or large (7-32-32-3, extended inputs)")
+                     "thesis (4-8-8-3 scattering) or large (8-32-32-3, horizon inputs)")
         ->capture_default_str();
+    c.app->add_option("--encoding", o->fit.encoding,
+                      "scattering inputs: thesis | extended | horizon (default: the network's "
+                      "own; large: horizon, extended: before issue 15)");
+    c.app->add_option("--horizon-fraction", o->fit.horizon_fraction,
+                      "fraction of scattering samples viewing near the horizon (default: thesis "
+                      "0, large 0.25)");
+    c.app->add_option("--loss-epsilon", o->fit.loss_epsilon,
+                      "eps of the scattering loss ln((y_hat + eps) / (y + eps)) (default: "
+                      "thesis 1e-4, large 1e-6)");
     c.app->add_option("--transmittance-samples", o->fit.transmittance_samples)
         ->capture_default_str();
     c.app->add_option("--scattering-samples", o->fit.scattering_samples)->capture_default_str();
@@ -130,8 +140,8 @@ Command AddFitCommand(CLI::App* root) {
         ->capture_default_str();
     c.app
         ->add_option("--final-learning-rate", o->fit.final_learning_rate,
-                     "step size at the last step (exponential decay; equal to --learning-rate: "
-                     "constant, as the thesis)")
+                     "the scattering network's step size at its last iteration (exponential "
+                     "decay; equal to --learning-rate: constant, as the thesis)")
         ->capture_default_str();
     c.app->add_option("--holdout", o->fit.holdout, "fraction of samples held out")
         ->capture_default_str();

@@ -25,7 +25,15 @@ namespace {
 constexpr const char* kFormat = "atmos-neural-1";
 
 const char* EncodingName(NeuralEncoding e) {
-    return e == NeuralEncoding::kThesis ? "thesis" : "extended";
+    switch (e) {
+        case NeuralEncoding::kThesis:
+            return "thesis";
+        case NeuralEncoding::kExtended:
+            return "extended";
+        case NeuralEncoding::kHorizon:
+            return "horizon";
+    }
+    return "thesis";
 }
 
 using json = nlohmann::json;
@@ -170,8 +178,10 @@ NeuralWeights NeuralWeightsFromJson(const std::string& text, const std::string& 
             w.encoding = NeuralEncoding::kThesis;
         } else if (enc == "extended") {
             w.encoding = NeuralEncoding::kExtended;
+        } else if (enc == "horizon") {
+            w.encoding = NeuralEncoding::kHorizon;
         } else {
-            Fail("encoding: expected 'thesis' or 'extended', got '", enc, "'");
+            Fail("encoding: expected 'thesis', 'extended' or 'horizon', got '", enc, "'");
         }
         if (!j.contains("atmosphere") || !j["atmosphere"].is_object()) Fail("atmosphere: missing");
         const json& a = j["atmosphere"];
@@ -333,7 +343,7 @@ const OptionTable<NeuralOptions>& NeuralModel::OptionRows() {
         OptionTable<NeuralOptions>()
             .Choice("network", &NeuralOptions::network,
                     {{"thesis", std::string("thesis")}, {"large", std::string("large")}},
-                    "shipped weights: thesis (4-8-8-3) or large (7-32-32-3, extended inputs)")
+                    "shipped weights: thesis (4-8-8-3) or large (8-32-32-3, horizon inputs)")
             .Text("weights", &NeuralOptions::weights,
                   "weights JSON written by `atmos fit` (default: the shipped ones for earth)");
     return table;

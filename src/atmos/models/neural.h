@@ -28,7 +28,8 @@
 // any camera, sun down to the fit's lowest mu_s (-0.35; lower: no sky).
 // Deviations: the ground gets no sky light; weights are per atmosphere.
 // Options: `network` thesis (the sizes above) | large (two hidden layers of 32,
-// extended input encoding, models/neural_net.h); `weights` FILE overrides both.
+// the `horizon` input encoding, models/neural_net.h); `weights` FILE overrides
+// both (any encoding the file names: thesis, extended, horizon).
 #pragma once
 
 #include <string>

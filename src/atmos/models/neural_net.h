@@ -25,7 +25,18 @@ enum class NeuralOutput : int { kSigmoid = 0, kExpNeg = 1 };
 //             (mu - mu_horizon(h)); transmittance as kThesis. Beyond the thesis:
 //             the halo and the horizon are given to the network as features
 //             instead of having to be learnt from nu and mu.
-enum class NeuralEncoding : int { kThesis = 0, kExtended = 1 };
+//  kHorizon:  kExtended's first six inputs, then the ray's lowest altitude
+//             (signed, negative below the horizon, / thickness, clamped to
+//             [-1, 1]) and a step, 1 for a ray below the horizon (it ends on the
+//             ground) and 0 above (issue 15). The radiance jumps at the horizon
+//             (from the ground: from the whole horizontal path to nothing;
+//             from above: the part beyond the tangent point) and, above it,
+//             follows the air's density at the lowest point, ~exp(-h_min / H),
+//             which is linear in h_min for the exp(-x) output. kExtended's
+//             smooth (mu - mu_horizon) made the network blur the jump and the
+//             steep limb (issue 15: horizontal rays from the ground near zero,
+//             the limb at 99 km 4-5x too bright).
+enum class NeuralEncoding : int { kThesis = 0, kExtended = 1, kHorizon = 2 };
 
 constexpr int kNeuralMaxInputs = 8;
 constexpr int kNeuralMaxHidden = 32;
@@ -91,7 +102,7 @@ using NeuralScatteringNet = NeuralNet<kNeuralMaxInputs, kNeuralMaxHidden>;
 // Number of inputs for each encoding.
 ATMOS_HD inline int NeuralTransmittanceInputs(NeuralEncoding) { return 2; }
 ATMOS_HD inline int NeuralScatteringInputs(NeuralEncoding e) {
-    return e == NeuralEncoding::kThesis ? 4 : 7;
+    return e == NeuralEncoding::kThesis ? 4 : e == NeuralEncoding::kExtended ? 7 : 8;
 }
 
 // Encodes (altitude, mu) for the transmittance network (seed 003 section 9.1):
@@ -113,7 +124,7 @@ ATMOS_HD inline void NeuralEncodeScattering(NeuralEncoding e, double altitude, d
     x[1] = static_cast<float>(ClampCosine(mu));
     x[2] = static_cast<float>(ClampCosine(mu_s));
     x[3] = static_cast<float>(ClampCosine(nu));
-    if (e == NeuralEncoding::kExtended) {
+    if (e != NeuralEncoding::kThesis) {
         x[4] = static_cast<float>(h);
         // Cornette-Shanks phase (seed 003 section 3.2 / seed 004), as a log.
         const double c = ClampCosine(nu);
@@ -123,7 +134,17 @@ ATMOS_HD inline void NeuralEncodeScattering(NeuralEncoding e, double altitude, d
         const double r = bottom + Max(altitude, 0.0);
         const double ratio = bottom / r;
         const double mu_horizon = -SafeSqrt(1.0 - ratio * ratio);
-        x[6] = static_cast<float>(ClampCosine(mu) - mu_horizon);
+        const double m = ClampCosine(mu);
+        if (e == NeuralEncoding::kExtended) {
+            x[6] = static_cast<float>(m - mu_horizon);
+        } else {
+            // Lowest point of the ray: the camera for mu >= 0, else the point
+            // where it is tangent to a sphere of radius r sqrt(1 - mu^2) (below
+            // the ground for a ray that hits it: negative altitude).
+            const double r_min = m >= 0.0 ? r : r * SafeSqrt(1.0 - m * m);
+            x[6] = static_cast<float>(Min(Max((r_min - bottom) / thickness, -1.0), 1.0));
+            x[7] = m < mu_horizon ? 1.0f : 0.0f;
+        }
     }
 }
 

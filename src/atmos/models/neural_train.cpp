@@ -20,8 +20,6 @@ namespace atmos {
 
 namespace {
 
-constexpr double kEps = 1e-4;  // of the log loss
-
 double Sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
 
 // A multilayer perceptron in double with the layout of NeuralNet (weights layer
@@ -124,25 +122,26 @@ struct Mlp {
 
 struct DataSet {
     int inputs = 0;
+    double eps = 1e-4;      // of the log loss ln(y + eps)
     std::vector<double> x;  // n x inputs
     std::vector<double> y;  // n x 3
     size_t Size() const { return y.size() / 3; }
 };
 
 // Per-sample loss and its gradient with respect to the output.
-double SampleLoss(const double* y_hat, const double* y, double* d_out) {
+double SampleLoss(const double* y_hat, const double* y, double eps, double* d_out) {
     double loss = 0.0;
     for (int c = 0; c < 3; ++c) {
-        const double e = std::log(y_hat[c] + kEps) - std::log(y[c] + kEps);
+        const double e = std::log(y_hat[c] + eps) - std::log(y[c] + eps);
         loss += e * e / 3.0;
-        if (d_out) d_out[c] = 2.0 * e / 3.0 / (y_hat[c] + kEps);
+        if (d_out) d_out[c] = 2.0 * e / 3.0 / (y_hat[c] + eps);
     }
     return loss;
 }
 
 // Adam (Kingma & Ba 2015, Algorithm 1) on mini-batches of `train`.
-void Train(Mlp* net, const DataSet& train, int steps, const NeuralFitOptions& o, uint64_t stream,
-           NeuralNetFitReport* report) {
+void Train(Mlp* net, const DataSet& train, int steps, double final_lr, const NeuralFitOptions& o,
+           uint64_t stream, NeuralNetFitReport* report) {
     const double beta1 = 0.9, beta2 = 0.999, adam_eps = 1e-8;
     std::vector<double> mw(net->w.size(), 0.0), vw(net->w.size(), 0.0);
     std::vector<double> mb(net->b.size(), 0.0), vb(net->b.size(), 0.0);
@@ -163,7 +162,7 @@ void Train(Mlp* net, const DataSet& train, int steps, const NeuralFitOptions& o,
                 std::min(n - 1, static_cast<size_t>(rng.Uniform() * static_cast<double>(n)));
             net->Forward(&train.x[i * static_cast<size_t>(train.inputs)], &acts);
             double d_out[3];
-            batch_loss += SampleLoss(acts.back().data(), &train.y[i * 3], d_out);
+            batch_loss += SampleLoss(acts.back().data(), &train.y[i * 3], train.eps, d_out);
             for (double& d : d_out) d /= o.batch;
             net->Backward(acts, d_out, &gw, &gb);
         }
@@ -175,8 +174,8 @@ void Train(Mlp* net, const DataSet& train, int steps, const NeuralFitOptions& o,
             loss_count = 0;
         }
         const double t = step + 1.0;
-        const double lr = o.learning_rate * std::pow(o.final_learning_rate / o.learning_rate,
-                                                     step / std::max(1.0, steps - 1.0));
+        const double lr = o.learning_rate *
+                          std::pow(final_lr / o.learning_rate, step / std::max(1.0, steps - 1.0));
         const double c1 = 1.0 - std::pow(beta1, t), c2 = 1.0 - std::pow(beta2, t);
         auto update = [&](std::vector<double>& p, std::vector<double>& g, std::vector<double>& m,
                           std::vector<double>& v) {
@@ -196,7 +195,7 @@ void Errors(const Mlp& net, const DataSet& d, double* rms_log, double* rel_mean)
     double sum = 0.0, abs_err = 0.0, abs_ref = 0.0;
     for (size_t i = 0; i < d.Size(); ++i) {
         net.Forward(&d.x[i * static_cast<size_t>(d.inputs)], &acts);
-        sum += SampleLoss(acts.back().data(), &d.y[i * 3], nullptr);
+        sum += SampleLoss(acts.back().data(), &d.y[i * 3], d.eps, nullptr);
         for (int c = 0; c < 3; ++c) {
             abs_err += std::fabs(acts.back()[static_cast<size_t>(c)] -
                                  d.y[i * 3 + static_cast<size_t>(c)]);
@@ -227,14 +226,15 @@ void Split(const DataSet& all, double holdout, DataSet* train, DataSet* test) {
     const size_t n_train = n - n_test;
     const size_t in = static_cast<size_t>(all.inputs);
     train->inputs = test->inputs = all.inputs;
+    train->eps = test->eps = all.eps;
     train->x.assign(all.x.begin(), all.x.begin() + static_cast<std::ptrdiff_t>(n_train * in));
     train->y.assign(all.y.begin(), all.y.begin() + static_cast<std::ptrdiff_t>(n_train * 3));
     test->x.assign(all.x.begin() + static_cast<std::ptrdiff_t>(n_train * in), all.x.end());
     test->y.assign(all.y.begin() + static_cast<std::ptrdiff_t>(n_train * 3), all.y.end());
 }
 
-NeuralNetFitReport FitOne(Mlp* net, const DataSet& all, int steps, const NeuralFitOptions& o,
-                          uint64_t stream) {
+NeuralNetFitReport FitOne(Mlp* net, const DataSet& all, int steps, double final_lr,
+                          const NeuralFitOptions& o, uint64_t stream) {
     DataSet train, test;
     Split(all, o.holdout, &train, &test);
     if (train.Size() == 0) Fail("fit: no training samples");
@@ -242,12 +242,12 @@ NeuralNetFitReport FitOne(Mlp* net, const DataSet& all, int steps, const NeuralF
     if (net->output == NeuralOutput::kExpNeg) {
         // Start the output at the data's mean log level: y = exp(-b).
         double mean = 0.0;
-        for (double v : train.y) mean += std::log(v + kEps);
+        for (double v : train.y) mean += std::log(v + train.eps);
         mean /= static_cast<double>(train.y.size());
         for (int c = 0; c < 3; ++c) net->b[net->b.size() - 3 + static_cast<size_t>(c)] = -mean;
     }
     NeuralNetFitReport r;
-    Train(net, train, steps, o, stream, &r);
+    Train(net, train, steps, final_lr, o, stream, &r);
     Errors(*net, train, &r.train_rms_log, nullptr);
     Errors(*net, test, &r.holdout_rms_log, &r.holdout_rel_mean);
     return r;
@@ -255,8 +255,7 @@ NeuralNetFitReport FitOne(Mlp* net, const DataSet& all, int steps, const NeuralF
 
 }  // namespace
 
-NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
-                        const NeuralFitOptions& o, NeuralFitReport* report) {
+NeuralFitChoices CheckNeuralFitOptions(const NeuralFitOptions& o) {
     if (o.network != "thesis" && o.network != "large") {
         Fail("fit: --network must be thesis or large, got '", o.network, "'");
     }
@@ -269,7 +268,35 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     }
     if (!(o.holdout >= 0.0 && o.holdout < 0.9)) Fail("fit: holdout must be in [0, 0.9)");
     const bool large = o.network == "large";
-    const NeuralEncoding enc = large ? NeuralEncoding::kExtended : NeuralEncoding::kThesis;
+    NeuralFitChoices c;
+    NeuralEncoding& enc = c.encoding;
+    enc = large ? NeuralEncoding::kHorizon : NeuralEncoding::kThesis;
+    if (o.encoding == "extended" || o.encoding == "horizon") {
+        if (!large) Fail("fit: --encoding ", o.encoding, " needs --network large");
+        enc = o.encoding == "extended" ? NeuralEncoding::kExtended : NeuralEncoding::kHorizon;
+    } else if (!o.encoding.empty() && o.encoding != "thesis") {
+        Fail("fit: --encoding must be thesis, extended or horizon, got '", o.encoding, "'");
+    } else if (o.encoding == "thesis" && large) {
+        Fail("fit: --encoding thesis needs --network thesis");
+    }
+    double& horizon_fraction = c.horizon_fraction;
+    horizon_fraction = o.horizon_fraction >= 0.0 ? o.horizon_fraction : (large ? 0.25 : 0.0);
+    if (!(horizon_fraction <= 1.0)) Fail("fit: --horizon-fraction must be in [0, 1]");
+    double& loss_epsilon = c.loss_epsilon;
+    loss_epsilon = o.loss_epsilon >= 0.0 ? o.loss_epsilon : (large ? 1e-6 : 1e-4);
+    if (!(loss_epsilon > 0.0 && loss_epsilon <= 1.0)) {
+        Fail("fit: --loss-epsilon must be in (0, 1]");
+    }
+    return c;
+}
+
+NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
+                        const NeuralFitOptions& o, NeuralFitReport* report) {
+    const NeuralFitChoices choices = CheckNeuralFitOptions(o);
+    const bool large = o.network == "large";
+    const NeuralEncoding enc = choices.encoding;
+    const double horizon_fraction = choices.horizon_fraction;
+    const double loss_epsilon = choices.loss_epsilon;
     const double thickness = atm.top_radius - atm.bottom_radius;
     const auto t0 = std::chrono::steady_clock::now();
 
@@ -288,7 +315,10 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
         tq[i].mu_s = 1.0;
         tq[i].azimuth_deg = 0.0;
     }
-    // Scattering data: all view directions, sun from the zenith to mu_s = -0.35.
+    // Scattering data: all view directions, sun from the zenith to mu_s = -0.35;
+    // a fraction of the views near the horizon, where the radiance jumps and
+    // (above the horizon, from high up) falls steeply with mu (issue 15). The
+    // draws of the uniform samples are those before issue 15.
     std::vector<SampleQuery> sq(static_cast<size_t>(o.scattering_samples));
     for (size_t i = 0; i < sq.size(); ++i) {
         Rng rng(o.seed, 0x5000000 + i, 0);
@@ -297,6 +327,14 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
         sq[i].mu = 2.0 * rng.Uniform() - 1.0;
         sq[i].mu_s = kNeuralMinMuS + (1.0 - kNeuralMinMuS) * rng.Uniform();
         sq[i].azimuth_deg = 180.0 * rng.Uniform();
+        Rng hrng(o.seed, 0x5800000 + i, 0);
+        if (hrng.Uniform() < horizon_fraction) {
+            const double ratio = atm.bottom_radius / (atm.bottom_radius + sq[i].altitude_m);
+            const double mu_h = -std::sqrt(std::max(0.0, 1.0 - ratio * ratio));
+            const double v = hrng.Uniform();
+            const double side = hrng.Uniform() < 0.5 ? -1.0 : 1.0;
+            sq[i].mu = std::clamp(mu_h + side * 0.15 * v * v, -1.0, 1.0);
+        }
     }
     auto sample = [&](const std::vector<SampleQuery>& queries) {
         return reference.Info().capabilities.stochastic
@@ -310,6 +348,7 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     DataSet td, sd;
     td.inputs = NeuralTransmittanceInputs(enc);
     sd.inputs = NeuralScatteringInputs(enc);
+    sd.eps = loss_epsilon;
     const size_t tin = static_cast<size_t>(td.inputs), sin_ = static_cast<size_t>(sd.inputs);
     td.x.assign(tq.size() * tin, 0.0);
     td.y.assign(tq.size() * 3, 0.0);
@@ -357,8 +396,10 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     }
     snet.output = NeuralOutput::kExpNeg;
     NeuralFitReport r;
-    r.transmittance = FitOne(&tnet, td, o.transmittance_steps, o, 0x71);
-    r.scattering = FitOne(&snet, sd, o.scattering_steps, o, 0x53);
+    // The step decay is the scattering network's only (issue 15: it made the
+    // transmittance network worse, held-out 0.222 against 0.199).
+    r.transmittance = FitOne(&tnet, td, o.transmittance_steps, o.learning_rate, o, 0x71);
+    r.scattering = FitOne(&snet, sd, o.scattering_steps, o.final_learning_rate, o, 0x53);
     const auto t2 = std::chrono::steady_clock::now();
     r.sample_seconds = std::chrono::duration<double>(t1 - t0).count();
     r.train_seconds = std::chrono::duration<double>(t2 - t1).count();
@@ -378,6 +419,10 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     w.fit_atmosphere = atm;
     nlohmann::json tj;
     tj["network"] = o.network;
+    tj["encoding"] = enc == NeuralEncoding::kThesis     ? "thesis"
+                     : enc == NeuralEncoding::kExtended ? "extended"
+                                                        : "horizon";
+    tj["horizon_fraction"] = horizon_fraction;
     tj["transmittance_samples"] = o.transmittance_samples;
     tj["scattering_samples"] = o.scattering_samples;
     tj["transmittance_steps"] = o.transmittance_steps;
@@ -387,7 +432,9 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     tj["final_learning_rate"] = o.final_learning_rate;
     tj["seed"] = o.seed;
     tj["holdout"] = o.holdout;
-    tj["loss"] = "mean squared ln((y_hat + 1e-4) / (y + 1e-4))";
+    tj["loss"] = "mean squared ln((y_hat + eps) / (y + eps))";
+    tj["transmittance_loss_epsilon"] = td.eps;
+    tj["scattering_loss_epsilon"] = sd.eps;
     tj["transmittance_train_rms_log"] = r.transmittance.train_rms_log;
     tj["transmittance_holdout_rms_log"] = r.transmittance.holdout_rms_log;
     tj["scattering_train_rms_log"] = r.scattering.train_rms_log;
