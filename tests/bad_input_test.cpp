@@ -119,6 +119,10 @@ TEST(BadInput, EveryCommandGivesOneLineAndExitTwo) {
         {"fit --model neural --network large --loss-epsilon 0 -o " + d + "/w.json",
          "--loss-epsilon"},
         {"fit --model neural --horizon-fraction 2 -o " + d + "/w.json", "--horizon-fraction"},
+        // A negative value once meant "the network's own" silently.
+        {"fit --model neural --horizon-fraction -0.5 -o " + d + "/w.json", "--horizon-fraction"},
+        {"fit --model neural --loss-epsilon -1 -o " + d + "/w.json", "--loss-epsilon"},
+        {"fit --model neural --loss-epsilon nan -o " + d + "/w.json", "--loss-epsilon"},
         {"render --quantity colour --size 8x4" + out, "unknown quantity"},
         // Models and their options: NaN, infinity, hexadecimal, out of range, wrong type.
         {"render --model nope --size 8x4" + out, "unknown model 'nope'"},

@@ -118,12 +118,14 @@ Command AddFitCommand(CLI::App* root) {
     c.app->add_option("--encoding", o->fit.encoding,
                       "scattering inputs: thesis | extended | horizon (default: the network's "
                       "own; large: horizon, extended: before issue 15)");
-    c.app->add_option("--horizon-fraction", o->fit.horizon_fraction,
-                      "fraction of scattering samples viewing near the horizon (default: thesis "
-                      "0, large 0.25)");
-    c.app->add_option("--loss-epsilon", o->fit.loss_epsilon,
-                      "eps of the scattering loss ln((y_hat + eps) / (y + eps)) (default: "
-                      "thesis 1e-4, large 1e-6)");
+    c.app->add_option_function<double>(
+        "--horizon-fraction", [o](const double& v) { o->fit.horizon_fraction = v; },
+        "fraction of scattering samples viewing near the horizon (default: thesis "
+        "0, large 0.25)");
+    c.app->add_option_function<double>(
+        "--loss-epsilon", [o](const double& v) { o->fit.loss_epsilon = v; },
+        "eps of the scattering loss ln((y_hat + eps) / (y + eps)) (default: "
+        "thesis 1e-4, large 1e-6)");
     c.app->add_option("--transmittance-samples", o->fit.transmittance_samples)
         ->capture_default_str();
     c.app->add_option("--scattering-samples", o->fit.scattering_samples)->capture_default_str();

@@ -280,10 +280,12 @@ NeuralFitChoices CheckNeuralFitOptions(const NeuralFitOptions& o) {
         Fail("fit: --encoding thesis needs --network thesis");
     }
     double& horizon_fraction = c.horizon_fraction;
-    horizon_fraction = o.horizon_fraction >= 0.0 ? o.horizon_fraction : (large ? 0.25 : 0.0);
-    if (!(horizon_fraction <= 1.0)) Fail("fit: --horizon-fraction must be in [0, 1]");
+    horizon_fraction = o.horizon_fraction ? *o.horizon_fraction : (large ? 0.25 : 0.0);
+    if (!(horizon_fraction >= 0.0 && horizon_fraction <= 1.0)) {
+        Fail("fit: --horizon-fraction must be in [0, 1]");
+    }
     double& loss_epsilon = c.loss_epsilon;
-    loss_epsilon = o.loss_epsilon >= 0.0 ? o.loss_epsilon : (large ? 1e-6 : 1e-4);
+    loss_epsilon = o.loss_epsilon ? *o.loss_epsilon : (large ? 1e-6 : 1e-4);
     if (!(loss_epsilon > 0.0 && loss_epsilon <= 1.0)) {
         Fail("fit: --loss-epsilon must be in (0, 1]");
     }

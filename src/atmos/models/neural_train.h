@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,16 +38,16 @@ struct NeuralFitOptions {
     std::string encoding;
     // Fraction of the scattering samples whose view direction is drawn near
     // the horizon (mu = mu_horizon(h) +- 0.15 v^2, v uniform; issue 15);
-    // negative = the network's own (thesis: 0, the thesis's uniform mu;
-    // large: 0.25).
-    double horizon_fraction = -1.0;
+    // unset = the network's own (thesis: 0, the thesis's uniform mu;
+    // large: 0.25); a set value must lie in [0, 1].
+    std::optional<double> horizon_fraction;
     // eps of the scattering network's loss, squared ln((y_hat + eps) / (y + eps)):
-    // values well below eps hardly count. Negative = the network's own
+    // values well below eps hardly count. Unset = the network's own
     // (thesis: 1e-4, as before; large: 1e-6, issue 15: at 1e-4 the radiance of
     // rays high in the atmosphere, ~1e-6 per unit irradiance, was not fitted:
     // horizontal rays at 99 km came out 3-4x too bright; 1e-7 and 3e-7 fitted
     // them better and the rest of the sky worse, docs/models/neural.md).
-    double loss_epsilon = -1.0;
+    std::optional<double> loss_epsilon;
     int transmittance_samples = 4096;
     int scattering_samples = 16384;
     int transmittance_steps = 3000;
