@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "atmos/error.h"
+#include "base/library_progress.h"
+#include "base/progress.h"
 #include "base/rng.h"
 #include "render/progressive.h"
 
@@ -142,7 +144,7 @@ double SampleLoss(const double* y_hat, const double* y, double* d_out) {
 
 // Adam (Kingma & Ba 2015, Algorithm 1) on mini-batches of `train`.
 void Train(Mlp* net, const DataSet& train, int steps, const NeuralFitOptions& o, uint64_t stream,
-           NeuralNetFitReport* report) {
+           NeuralNetFitReport* report, Progress* progress) {
     const double beta1 = 0.9, beta2 = 0.999, adam_eps = 1e-8;
     std::vector<double> mw(net->w.size(), 0.0), vw(net->w.size(), 0.0);
     std::vector<double> mb(net->b.size(), 0.0), vb(net->b.size(), 0.0);
@@ -169,6 +171,7 @@ void Train(Mlp* net, const DataSet& train, int steps, const NeuralFitOptions& o,
         }
         loss_acc += batch_loss / o.batch;
         ++loss_count;
+        progress->Add(1);
         if ((step + 1) % report_every == 0) {
             report->loss.push_back(loss_acc / loss_count);
             loss_acc = 0.0;
@@ -234,7 +237,7 @@ void Split(const DataSet& all, double holdout, DataSet* train, DataSet* test) {
 }
 
 NeuralNetFitReport FitOne(Mlp* net, const DataSet& all, int steps, const NeuralFitOptions& o,
-                          uint64_t stream) {
+                          uint64_t stream, Progress* progress) {
     DataSet train, test;
     Split(all, o.holdout, &train, &test);
     if (train.Size() == 0) Fail("fit: no training samples");
@@ -247,7 +250,7 @@ NeuralNetFitReport FitOne(Mlp* net, const DataSet& all, int steps, const NeuralF
         for (int c = 0; c < 3; ++c) net->b[net->b.size() - 3 + static_cast<size_t>(c)] = -mean;
     }
     NeuralNetFitReport r;
-    Train(net, train, steps, o, stream, &r);
+    Train(net, train, steps, o, stream, &r, progress);
     Errors(*net, train, &r.train_rms_log, nullptr);
     Errors(*net, test, &r.holdout_rms_log, &r.holdout_rel_mean);
     return r;
@@ -357,8 +360,11 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     }
     snet.output = NeuralOutput::kExpNeg;
     NeuralFitReport r;
-    r.transmittance = FitOne(&tnet, td, o.transmittance_steps, o, 0x71);
-    r.scattering = FitOne(&snet, sd, o.scattering_steps, o, 0x53);
+    // The training's steps as a progress bar (the CLI's `fit`; base/library_progress.h).
+    Progress progress("fit: training", int64_t{o.transmittance_steps} + o.scattering_steps,
+                      LibraryProgressEnabled());
+    r.transmittance = FitOne(&tnet, td, o.transmittance_steps, o, 0x71, &progress);
+    r.scattering = FitOne(&snet, sd, o.scattering_steps, o, 0x53, &progress);
     const auto t2 = std::chrono::steady_clock::now();
     r.sample_seconds = std::chrono::duration<double>(t1 - t0).count();
     r.train_seconds = std::chrono::duration<double>(t2 - t1).count();
