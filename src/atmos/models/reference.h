@@ -294,17 +294,20 @@ struct ReferenceEvaluator {
     // majorants are scaled by k chosen from tau_bar, the ray's majorant
     // optical depth (computed exactly by walking the shells):
     //   tau_bar <= 1.77: k = max(1, 20 tau_bar): relative variance <= 5 %, <= 64 steps;
-    //   1.77 .. 64:      k = 64 / tau_bar:       64 steps; relative variance
-    //                    <= e - 1 up to tau = 8, second moment <= exp(-tau) beyond;
-    //   > 64:            k = 1:                  tau_bar steps, second moment exp(-tau).
-    // The cost per shadow ray is at most max(64, tau_bar) steps, linear in
-    // the optical depth (issue 18 item 9: k = tau_bar beyond 8 cost tau_bar^2
-    // steps, hours for a small image of a dense layer); the rays that pay with
-    // relative variance are those in deep shadow (T < 3e-4), whose absolute
-    // second moment stays below exp(-tau) (< 3.4e-4). Unbiased for any k >= 1.
+    //   1.77 .. 8:       k = 64 / tau_bar:       <= e - 1, 64 steps;
+    //   8 .. 32:         k = tau_bar:            <= e - 1, tau_bar^2 <= 1024 steps;
+    //   > 32:            k = max(1, 1024 / tau_bar): max(1024, tau_bar) steps.
+    // Beyond 32 (deep shadow: T = exp(-32) = 1.3e-14 where the majorant is
+    // tight) the relative variance grows (exp(tau tau_bar / 1024) - 1) but the second moment stays
+    // below exp(-tau); the cost per shadow ray is at most max(1024, tau_bar) steps, linear in the
+    // optical depth (issue 18 item 9: k = tau_bar without the cap cost tau_bar^2 steps, 7.3e5 for a
+    // horizontal ray near the ground of a dense layer, and a 64x36 image was projected at hours).
+    // Unbiased for any k >= 1.
     ATMOS_HD static double RatioTrackingScale(double tau_bar) {
         if (tau_bar <= 1.77) return Max(1.0, 20.0 * tau_bar);
-        return Max(1.0, 64.0 / tau_bar);
+        if (tau_bar <= 8.0) return 64.0 / tau_bar;
+        if (tau_bar <= 32.0) return tau_bar;
+        return Max(1.0, 1024.0 / tau_bar);
     }
 
     // `steps` (optional) counts the tentative collisions (tests: the cost).
