@@ -19,6 +19,7 @@
 #include "atmos/model.h"
 #include "atmos/view.h"
 #include "base/parallel.h"
+#include "dense_mie.h"
 #include "models/naive.h"
 #include "models/reference.h"
 #include "physics/transmittance.h"
@@ -112,12 +113,7 @@ TEST(ReferenceTransmittance, RatioTrackingIsUnbiased) {
 // rays through issue 18's dense Mie layer (0.01 /m, vertical optical depth
 // 12) from the zenith to the horizon (tau_bar from ~13 to thousands).
 TEST(ReferenceTransmittance, RatioTrackingCostIsLinearInADenseLayer) {
-    AtmosphereParameters atm = EarthAtmosphere();
-    atm.rayleigh_scattering = Vec3d(0.0);
-    atm.mie_extinction = Vec3d(0.01);
-    atm.mie_scattering = Vec3d(0.003);
-    atm.mie_phase_g = 0.9;
-    atm.absorption_extinction = Vec3d(0.0);
+    const AtmosphereParameters atm = DenseMiePlanet();
     const ReferenceEvaluator e = MakeReference(atm);
     struct Case {
         double altitude, mu;
