@@ -501,6 +501,102 @@ TEST(Cli, SigintCheckpointsAndStops) {
     EXPECT_FALSE(fs::exists(dir / "i.exr"));
 }
 
+// Issue 18 item 10: a checkpoint may fall inside a pass. With
+// --checkpoint-every 0 every band of one row is committed; a SIGINT delivered
+// at the third commit (strace) stops the render inside its first pass with one
+// line, and --resume finishes it to exactly the uninterrupted image.
+TEST(Cli, SigintInsideAPassCheckpointsAndResumesToTheSameImage) {
+    if (std::system("strace -o /dev/null true > /dev/null 2>&1") != 0) {
+        GTEST_SKIP() << "strace is not available";
+    }
+    const fs::path dir = TempDir() / "sigint_band";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string base =
+        "render --model reference --view plane-dawn --size 24x12 -q --seed 5 --spp 4 "
+        "--pass-spp 2 --checkpoint-every 0 --checkpoint " +
+        (dir / "ck").string() + " ";
+    const Result full = RunAtmos(base + "-o " + (dir / "full.exr").string());
+    ASSERT_EQ(full.status, 0) << full.err;
+    const std::string renames = "rename,renameat,renameat2";
+    const std::string cmd = "strace -f -o /dev/null -e trace=" + renames + " -e inject=" + renames +
+                            ":signal=SIGINT:when=3 " + ATMOS_CLI_PATH + " " + base + "-o " +
+                            (dir / "cut.exr").string() + " > /dev/null 2> " +
+                            (dir / "err").string();
+    const int raw = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(raw));
+    EXPECT_EQ(WEXITSTATUS(raw), 2);
+    const std::string err = Slurp(dir / "err");
+    EXPECT_NE(err.find("atmos: error: interrupted by SIGINT in pass 1 of 2"), std::string::npos)
+        << err;
+    EXPECT_NE(err.find("4 of 12 rows"), std::string::npos) << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_FALSE(fs::exists(dir / "cut.exr"));
+    const Result resumed = RunAtmos(base + "--resume -o " + (dir / "resumed.exr").string());
+    ASSERT_EQ(resumed.status, 0) << resumed.err;
+    EXPECT_TRUE(Slurp(dir / "resumed.exr") == Slurp(dir / "full.exr"));
+    ExpectError("render --model reference --size 8x4 -q --checkpoint-every -1 -o " +
+                    (dir / "x.exr").string(),
+                "--checkpoint-every must be in [0, 1e6] seconds");
+}
+
+// Issue 18 item 9: long work shows progress. ATMOS_PROGRESS=1 draws every
+// enabled bar (whatever stderr is, with its final line), so each command's
+// bars can be checked here: `fit` (its samples and its training), Hillaire's
+// `sample` (one bar over every sky-view group), the path tracer's `sample`,
+// a Monte Carlo `render`. With --quiet there is none, and without the variable
+// none either (stderr is a file here, not a terminal; checked on `fit`).
+TEST(Cli, ProgressBarsShowUnlessQuiet) {
+    const std::string w = (TempDir() / "progress_fit.json").string();
+    const std::string img = (TempDir() / "progress.exr").string();
+    const std::string two_groups =
+        "altitude_m,mu,mu_s,azimuth_deg\n0,0.5,0.5,0\n0,0.2,0.5,90\n1000,0.5,0.3,0\n";
+    struct Case {
+        std::string args, quiet, input;
+        std::vector<std::pair<std::string, int>> bars;  // label, how many final lines
+    };
+    const std::vector<Case> cases = {
+        {"fit --model neural --reference naive --transmittance-samples 50 "
+         "--scattering-samples 50 --transmittance-iterations 20 --scattering-iterations 20 -o " +
+             w,
+         "--quiet",
+         "",
+         {{"sample [", 2}, {"fit: training [", 1}}},
+        {"sample --model hillaire", "-q", two_groups, {{"sample [", 1}}},
+        {"sample --model reference --spp 2", "-q", two_groups, {{"sample [", 1}}},
+        {"render --model reference --view plane-dawn --size 8x4 --spp 2 -o " + img,
+         "-q",
+         "",
+         {{"reference [", 1}}},
+    };
+    // Final lines: the bar full and the time taken (a redraw at 100 % says "ETA").
+    auto count = [](const std::string& text, const std::string& needle) {
+        int n = 0;
+        for (size_t at = text.find(needle); at != std::string::npos;
+             at = text.find(needle, at + 1)) {
+            if (text.compare(at + needle.size(), 3, "ETA") != 0) ++n;
+        }
+        return n;
+    };
+    for (const Case& c : cases) {
+        ::setenv("ATMOS_PROGRESS", "1", 1);
+        const Result shown = RunAtmos(c.args, c.input);
+        const Result quiet = RunAtmos(c.args + " " + c.quiet, c.input);
+        ::unsetenv("ATMOS_PROGRESS");
+        // Without the variable (the bars' one switch, shared): the first case only.
+        const Result plain = &c == &cases.front() ? RunAtmos(c.args, c.input) : Result{0, "", ""};
+        for (const Result* r : {&shown, &quiet, &plain}) ASSERT_EQ(r->status, 0) << c.args;
+        for (const auto& [label, lines] : c.bars) {
+            // A final line: the bar full, then the time and a newline.
+            EXPECT_EQ(count(shown.err, label + "##############################] 100.0% "), lines)
+                << c.args << "\n"
+                << shown.err;
+        }
+        EXPECT_EQ(quiet.err.find("%"), std::string::npos) << c.args << "\n" << quiet.err;
+        EXPECT_EQ(plain.err.find("%"), std::string::npos) << c.args << "\n" << plain.err;
+    }
+}
+
 // Issue 18 item 10: compare -o DIR keeps its render cache under DIR.
 TEST(Cli, CompareCachesUnderItsOutput) {
     const fs::path dir = TempDir() / "compare_cache";
@@ -591,6 +687,48 @@ TEST(Cli, ValidateKiderOnTwoCaptures) {
     EXPECT_LT(std::stod(f[6]), std::stod(f[7])) << overall;
     ExpectError("validate kider-2013 --data /nonexistent", "kider_ref.csv");
     ExpectError("validate other", "unknown data set");
+}
+
+// Issue 18: text outputs (validate's CSV, compare's CSVs and HTML report,
+// bench's CSVs) are written through a temporary file and one rename, like the
+// images: a write that fails (here a file-size limit of 1 KiB, as a full disk
+// would) is one clear error and leaves the previous file as it was and no
+// temporary behind (std::ofstream left a truncated file under the final name).
+TEST(Cli, TextOutputsAreWrittenAtomically) {
+    if (std::system("bash -c 'ulimit -f 1' > /dev/null 2>&1") != 0) GTEST_SKIP() << "no bash";
+    const fs::path dir = TempDir() / "atomic_text";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const fs::path data = fs::path(ATMOS_SOURCE_DIR) / "tests" / "data" / "kider-2013";
+    const std::pair<std::string, fs::path> cases[] = {
+        {"validate kider-2013 -q --models naive --data " + data.string() + " -o " +
+             (dir / "v.csv").string(),
+         dir / "v.csv"},
+        {"compare --models naive --reference flat --views ground-noon --size 8x4 --quiet "
+         "--no-npy -o " +
+             (dir / "cmp").string(),
+         dir / "cmp" / "index.html"},
+    };
+    for (const auto& [args, target] : cases) {
+        const Result first = RunAtmos(args);
+        ASSERT_EQ(first.status, 0) << args << "\n" << first.err;
+        const std::string before = Slurp(target);
+        ASSERT_GT(before.size(), 1024u) << target;
+        const std::string cmd = "bash -c \"trap '' XFSZ; ulimit -f 1; exec " +
+                                std::string(ATMOS_CLI_PATH) + " " + args + "\" > /dev/null 2> " +
+                                (dir / "err").string();
+        const int raw = std::system(cmd.c_str());
+        ASSERT_TRUE(WIFEXITED(raw)) << args;
+        EXPECT_EQ(WEXITSTATUS(raw), 2) << args;
+        const std::string err = Slurp(dir / "err");
+        EXPECT_EQ(err.rfind("atmos: error: cannot write '", 0), 0u) << err;
+        EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+        EXPECT_TRUE(Slurp(target) == before) << target << " changed";
+        for (const auto& entry : fs::directory_iterator(target.parent_path())) {
+            EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos)
+                << entry.path();
+        }
+    }
 }
 
 // Issue 17: compare --wavelengths compares the spectral renders as linear sRGB.

@@ -37,6 +37,7 @@
 #include "atmos/atmosphere.h"
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "dense_mie.h"
 #include "physics/density.h"
 #include "physics/exp_quadrature.h"
 #include "physics/phase.h"
@@ -45,21 +46,6 @@
 namespace {
 
 using namespace atmos;
-
-AtmosphereParameters DenseMiePlanet() {
-    // Issue 18 item 4's dense Mie layer: 0.01 /m extinction, albedo 0.3, g 0.9,
-    // 1.2 km scale height (vertical optical depth 12); no Rayleigh, no ozone,
-    // a black ground.
-    AtmosphereParameters a = EarthAtmosphere();
-    a.rayleigh_scattering = Vec3d(0.0);
-    a.mie_extinction = Vec3d(0.01);
-    a.mie_scattering = Vec3d(0.003);
-    a.mie_phase_g = 0.9;
-    a.absorption_extinction = Vec3d(0.0);
-    a.ground_albedo = Vec3d(0.0);
-    ValidateAtmosphere(a);
-    return a;
-}
 
 double RadianceBound(const AtmosphereParameters& a) {
     const double sun = 1.0 / (kPi * a.sun_angular_radius * a.sun_angular_radius);

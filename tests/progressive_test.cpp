@@ -44,14 +44,18 @@ class CoinModel : public Model {
     }
     void RenderPass(const RenderRequest& request, const MonteCarloPass& pass, Image* out,
                     Progress* progress) const override {
-        ++passes_rendered;
-        out->Resize(request.width, request.height);
-        for (int y = 0; y < request.height; ++y) {
+        if (bands_rendered == fail_at_band) throw Error("coin: an injected failure");
+        ++bands_rendered;
+        if (pass.row_begin == 0) ++passes_rendered;
+        const int rows = pass.rows > 0 ? pass.rows : request.height - pass.row_begin;
+        out->Resize(request.width, rows);
+        for (int y = 0; y < rows; ++y) {
+            const int row = pass.row_begin + y;
             for (int x = 0; x < request.width; ++x) {
-                out->Set(x, y, Rgb(Mean(pass, static_cast<uint64_t>(y * request.width + x))));
+                out->Set(x, y, Rgb(Mean(pass, static_cast<uint64_t>(row * request.width + x))));
             }
         }
-        if (progress) progress->Add(static_cast<int64_t>(request.width) * request.height);
+        if (progress) progress->Add(static_cast<int64_t>(request.width) * rows);
     }
     std::vector<SampleAnswer> SamplePass(const std::vector<SampleQuery>& queries,
                                          const MonteCarloPass& pass) const override {
@@ -70,7 +74,9 @@ class CoinModel : public Model {
         return sum / static_cast<double>(pass.samples);
     }
 
-    mutable int passes_rendered = 0;
+    mutable int passes_rendered = 0;  // passes begun at row 0
+    mutable int bands_rendered = 0;
+    mutable int fail_at_band = -1;  // >= 0: RenderPass throws for that band (0: the first)
 
   private:
     ModelInfo info_;
@@ -351,6 +357,63 @@ TEST(Progressive, RendersToANoiseTargetOrTheCap) {
     // A noise target out of range is one clear error.
     request.monte_carlo.noise_target = 1.5;
     EXPECT_THROW(model.Render(request, &resumed), Error);
+}
+
+}  // namespace
+}  // namespace atmos
+
+namespace atmos {
+namespace {
+
+// Issue 18 item 10: a checkpoint may fall inside a pass (bands of rows; with
+// checkpoint_seconds 0 one row each and a checkpoint after every band). A
+// render stopped by a failure at any band resumes from its last checkpoint to
+// exactly the uninterrupted image and variance, rendering only the bands left:
+// plain passes (a short last one included) and noise-targeted pairs (stopped
+// inside an odd pass or after an even one).
+TEST(Progressive, ACheckpointInsideAPassResumesToTheSameImage) {
+    const std::filesystem::path dir = TestDir("progressive_bands");
+    for (const bool noise : {false, true}) {
+        RenderRequest request = CoinRequest(10, 4);  // 3 passes (4, 4, 2) of 7 rows
+        request.height = 7;
+        if (noise) {
+            request.monte_carlo.spp = 8;
+            request.monte_carlo.pass_spp = 2;  // 4 passes (2 pairs), the noise not reached
+            request.monte_carlo.noise_target = 1e-6;
+        }
+        const int bands = noise ? 28 : 21;
+        Image full, full_variance;
+        request.variance = &full_variance;
+        const CoinModel whole(true);
+        whole.Render(request, &full);
+        request.checkpoint = (dir / "coin").string();
+        request.monte_carlo.checkpoint_seconds = 0.0;
+        for (const int k : {1, 3, 7, 8, 12, 15, 20, 24}) {
+            if (k >= bands) continue;
+            std::filesystem::remove(request.checkpoint + ".bin");
+            const CoinModel failing(true);
+            failing.fail_at_band = k;
+            request.resume = false;
+            Image image, variance;
+            request.variance = &variance;
+            EXPECT_THROW(failing.Render(request, &image), Error) << k;
+            const CoinModel model(true);
+            request.resume = true;
+            model.Render(request, &image);
+            EXPECT_EQ(model.bands_rendered, bands - k) << noise << " " << k;
+            ASSERT_EQ(image.size(), full.size());
+            EXPECT_EQ(std::memcmp(image.data(), full.data(), full.size() * sizeof(float)), 0)
+                << noise << " " << k;
+            EXPECT_EQ(
+                std::memcmp(variance.data(), full_variance.data(), full.size() * sizeof(float)), 0)
+                << noise << " " << k;
+        }
+    }
+    // A checkpoint interval that is not a number of seconds is one clear error.
+    RenderRequest request = CoinRequest(4, 2);
+    request.monte_carlo.checkpoint_seconds = -1.0;
+    Image image;
+    EXPECT_THROW(CoinModel(true).Render(request, &image), Error);
 }
 
 }  // namespace

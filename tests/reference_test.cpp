@@ -19,6 +19,7 @@
 #include "atmos/model.h"
 #include "atmos/view.h"
 #include "base/parallel.h"
+#include "dense_mie.h"
 #include "models/naive.h"
 #include "models/reference.h"
 #include "physics/transmittance.h"
@@ -102,6 +103,43 @@ TEST(ReferenceTransmittance, RatioTrackingIsUnbiased) {
             EXPECT_NEAR(stats.Mean()[ch], expected[ch], 4.0 * stats.StdError()[ch] + 1e-12)
                 << "altitude " << c.altitude << " mu " << c.mu << " channel " << ch;
         }
+    }
+}
+
+// Issue 18 item 9: a shadow ray's ratio tracking costs at most
+// max(1024, tau_bar) tentative collisions (tau_bar: its majorant optical
+// depth), linear in the optical depth (the majorants scaled by tau_bar beyond 8
+// cost tau_bar^2, hours for a small image of a dense layer), and stays unbiased:
+// rays through issue 18's dense Mie layer (0.01 /m, vertical optical depth
+// 12) from the zenith to the horizon (tau_bar from ~13 to thousands).
+TEST(ReferenceTransmittance, RatioTrackingCostIsLinearInADenseLayer) {
+    const AtmosphereParameters atm = DenseMiePlanet();
+    const ReferenceEvaluator e = MakeReference(atm);
+    struct Case {
+        double altitude, mu;
+        int samples;
+    };
+    for (const Case& c : {Case{0.0, 1.0, 4000}, Case{2000.0, 0.5, 4000}, Case{6000.0, 0.05, 4000},
+                          Case{500.0, 0.0, 100}}) {
+        const Vec3d p(0.0, 0.0, atm.bottom_radius + c.altitude);
+        const Vec3d dir(std::sqrt(1.0 - c.mu * c.mu), 0.0, c.mu);
+        const int shell = e.shells.ShellOf(p.z);
+        const double tau_bar = e.MajorantDepth(p, dir, shell, 1e300);
+        Stats stats;
+        int64_t steps = 0;
+        for (int i = 0; i < c.samples; ++i) {
+            Rng rng(9, 2, static_cast<uint64_t>(i));
+            stats.Add(e.RatioTracking(p, dir, shell, rng, &steps));
+        }
+        const double mean_steps = static_cast<double>(steps) / c.samples;
+        EXPECT_LE(mean_steps, 1.2 * std::max(1024.0, tau_bar) + 8.0)
+            << "altitude " << c.altitude << " mu " << c.mu << " tau_bar " << tau_bar;
+        const double length = DistanceToTopAtmosphereBoundary(p.z, c.mu, atm.top_radius);
+        const Vec3d expected = Exp(-OpticalDepth(atm, p, dir, length, 20000));
+        EXPECT_NEAR(stats.Mean().x, expected.x, 4.0 * stats.StdError().x + 1e-12)
+            << "altitude " << c.altitude << " mu " << c.mu << " tau_bar " << tau_bar;
+        std::printf("altitude %g mu %g: tau_bar %.4g, %.1f steps, T %.4g (expected %.4g)\n",
+                    c.altitude, c.mu, tau_bar, mean_steps, stats.Mean().x, expected.x);
     }
 }
 

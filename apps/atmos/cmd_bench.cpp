@@ -42,6 +42,7 @@
 #include "cli_monte_carlo.h"
 #include "harness/machine.h"
 #include "harness/spectral_run.h"
+#include "io/output_path.h"
 #include "render/stages.h"
 
 namespace fs = std::filesystem;
@@ -116,8 +117,8 @@ int BenchSpectral(const BenchOptions& o, const std::vector<ModelSpec>& models,
     const AtmosphereParameters rgb = LoadAtmosphere(o.atmosphere, o.sets);
     if (fs::path(o.output).has_parent_path())
         fs::create_directories(fs::path(o.output).parent_path());
-    std::ofstream csv(o.output);
-    if (!csv) Fail("cannot write '", o.output, "'");
+    CheckOutputFile(o.output);
+    TextOutput csv(o.output);  // written at the end, atomically
     csv << "model,view,width,height,wavelengths,batches,threads,rgb_prepare_s,rgb_render_s,"
            "spectral_prepare_s,spectral_render_s,prepare_ratio,render_ratio,repeat\n";
     for (const ModelSpec& spec : models) {
@@ -160,7 +161,7 @@ int BenchSpectral(const BenchOptions& o, const std::vector<ModelSpec>& models,
                 b > 0 ? d / b : 0.0);
         }
     }
-    if (!csv) Fail("cannot write '", o.output, "'");
+    csv.Commit();
     std::printf("wrote %s\n", o.output.c_str());
     return 0;
 }
@@ -212,8 +213,8 @@ int CmdBench(const BenchOptions& o) {
     const std::string cpu = CpuName(), compiler = CompilerName();
     if (fs::path(o.output).has_parent_path())
         fs::create_directories(fs::path(o.output).parent_path());
-    std::ofstream csv(o.output);
-    if (!csv) Fail("cannot write '", o.output, "'");
+    CheckOutputFile(o.output);
+    TextOutput csv(o.output);  // written at the end, atomically
     csv << "model,view,width,height,quantity,threads,prepare_s,render_median_s,render_min_s,"
            "render_max_s,repeat,megapixels_per_s,paths_per_s,cpu,compiler,backend\n";
     const std::string stages_path = !o.stages_output.empty()
@@ -221,8 +222,8 @@ int CmdBench(const BenchOptions& o) {
                                         : (fs::path(o.output).parent_path() /
                                            (fs::path(o.output).stem().string() + "_stages.csv"))
                                               .string();
-    std::ofstream stages_csv(stages_path);
-    if (!stages_csv) Fail("cannot write '", stages_path, "'");
+    CheckOutputFile(stages_path);
+    TextOutput stages_csv(stages_path);
     stages_csv << "model,view,stage,items,backend,runs,kernel_median_ms,total_median_ms,bytes_up,"
                   "bytes_down\n";
     auto write_stages = [&](const std::string& model, const std::string& view,
@@ -317,8 +318,8 @@ int CmdBench(const BenchOptions& o) {
             std::fflush(stdout);
         }
     }
-    if (!csv) Fail("cannot write '", o.output, "'");
-    if (!stages_csv) Fail("cannot write '", stages_path, "'");
+    csv.Commit();
+    stages_csv.Commit();
     std::printf("%s: %d threads, %s, %s; %dx%d, median of %d after %d warm-up%s; wrote %s, %s\n",
                 BackendName(backend), threads, cpu.c_str(), compiler.c_str(), width, height, repeat,
                 warmup, on_device ? " (kernel time, CUDA events)" : "", o.output.c_str(),

@@ -11,6 +11,7 @@
 #include "atmos/atmosphere.h"
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "base/library_progress.h"
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "io/output_path.h"
@@ -40,6 +41,9 @@ int CmdFit(const FitOptions& o) {
     CheckOutputFile(o.output);     // before the fit (io/output_path.h)
     CheckNeuralFitOptions(o.fit);  // before the reference's precomputation
     ThreadLimit limit(o.threads);
+    // Progress bars (the reference's precomputation and samples, the training)
+    // on a terminal for work over a second, unless --quiet.
+    const LibraryProgressScope progress(!o.quiet);
     const AtmosphereParameters atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
     const ModelSpec spec = ParseModelSpec(o.reference);
     if (spec.name == o.model) Fail("fit: --reference cannot be the model being fitted");
@@ -69,11 +73,7 @@ int CmdFit(const FitOptions& o) {
         w.training_json = t;
     }
     const std::string text = NeuralWeightsToJson(w);
-    std::ofstream out(o.output, std::ios::binary);
-    if (!out) Fail("fit: cannot write '", o.output, "'");
-    out << text;
-    out.close();
-    if (!out) Fail("fit: error writing '", o.output, "'");
+    WriteFileAtomically(o.output, text);
     if (!o.quiet) {
         auto line = [](const char* name, const NeuralNetFitReport& r) {
             std::printf(

@@ -41,6 +41,7 @@ struct RenderOptions {
     std::string checkpoint;  // Monte Carlo models: checkpoint stem (default: OUTPUT.ckpt)
     bool resume = false;
     bool keep_checkpoint = false;
+    double checkpoint_every = 10.0;  // seconds between checkpoints, at most
     MonteCarloFlags monte_carlo;
     SpectralFlags spectral;
 };
@@ -98,13 +99,17 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     if (!std::isfinite(ro.exposure) || ro.exposure < 0.0f) {
         Fail("--exposure must be a positive number");
     }
+    if (!(ro.checkpoint_every >= 0.0 && ro.checkpoint_every <= 1e6)) {
+        Fail("--checkpoint-every must be in [0, 1e6] seconds");
+    }
 
     ThreadLimit limit(common.threads);
     const BackendScope backend(ParseBackend(common.backend));
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(GivenModel(common));
     RequireQuantity(model->Info(), quantity);
-    const MonteCarloSettings monte_carlo = ro.monte_carlo.Settings(model->Info());
+    MonteCarloSettings monte_carlo = ro.monte_carlo.Settings(model->Info());
+    monte_carlo.checkpoint_seconds = ro.checkpoint_every;
     std::vector<View> views;
     if (all_views) {
         views = StandardViews(atmosphere);
@@ -215,6 +220,12 @@ Command AddRenderCommand(CLI::App* root) {
                      "Monte Carlo models: keep the checkpoint after the image is written (to "
                      "extend the render later with a larger --spp and --resume); by default it "
                      "is deleted");
+    render
+        ->add_option("--checkpoint-every", ro->checkpoint_every,
+                     "Monte Carlo models: the longest time between checkpoints, in seconds "
+                     "(passes are rendered in bands of rows of about a second, so this holds "
+                     "inside long passes too; 0: after every band of one row)")
+        ->capture_default_str();
     render->add_flag("--resume", ro->resume,
                      "Monte Carlo models: continue from the checkpoint of the same render");
     AddMonteCarloFlags(render, &ro->monte_carlo, true);

@@ -134,9 +134,7 @@ void WriteValidateHtml(const std::string& path, const std::vector<KiderSample>& 
         }
         html << "</svg>\n";
     }
-    std::ofstream out(path);
-    out << html.str();
-    if (!out) Fail("cannot write '", path, "'");
+    WriteFileAtomically(path, html.str());
 }
 
 int CmdValidate(const ValidateOptions& o) {
@@ -250,9 +248,7 @@ int CmdValidate(const ValidateOptions& o) {
     if (o.output.empty()) {
         std::fputs(csv.str().c_str(), stdout);
     } else {
-        std::ofstream out(o.output);
-        out << csv.str();
-        if (!out) Fail("cannot write '", o.output, "'");
+        WriteFileAtomically(o.output, csv.str());
     }
     return 0;
 }

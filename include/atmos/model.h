@@ -87,6 +87,11 @@ struct MonteCarloSettings {
     // the mean of the odd passes (two independent halves) is at or below this,
     // or spp is reached (render/progressive.h).
     double noise_target = 0.0;
+    // Checkpointed renders (RenderRequest::checkpoint): the longest time
+    // between two checkpoints, in seconds. Passes are rendered in bands of
+    // rows (about a second each; 0: one row) and a checkpoint may follow any
+    // band, so it also bounds what a kill loses (issue 18 item 10).
+    double checkpoint_seconds = 10.0;
 };
 
 // What a Monte Carlo render reached (RenderRequest::report).
@@ -101,6 +106,11 @@ struct MonteCarloPass {
     uint64_t seed = 0;
     int64_t first_sample = 0;
     int64_t samples = 1;
+    // The band of image rows to render: [row_begin, row_begin + rows) (rows 0:
+    // every row). Pixels depend on their coordinates only, so a pass rendered
+    // in bands is the pass rendered whole.
+    int row_begin = 0;
+    int rows = 0;
 };
 
 class Progress;
@@ -141,8 +151,9 @@ class Model {
 
     // Monte Carlo models (ModelCapabilities::stochastic) provide one pass; the
     // progressive driver (src/atmos/render/progressive.h) runs the passes and
-    // is their Render and Sample. RenderPass renders the pass's mean into `out`
-    // (resized), advancing `progress` (may be null) by one per pixel; PassKey
+    // is their Render and Sample. RenderPass renders the pass's mean over its
+    // band of rows into `out` (resized to width x rows), advancing `progress`
+    // (may be null) by one per pixel; PassKey
     // is JSON text of everything of the model that determines a pass besides
     // the request (options, atmosphere): a checkpoint resumes only the same.
     // Others throw atmos::Error.

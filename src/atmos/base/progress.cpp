@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 
 namespace atmos {
 
@@ -12,6 +14,14 @@ namespace {
 std::atomic<bool> g_library_progress{false};
 constexpr double kQuietSeconds = 1.0;   // show nothing for work shorter than this
 constexpr double kRedrawSeconds = 0.1;  // at most 10 redraws a second
+
+// ATMOS_PROGRESS=1: every enabled bar is drawn, from the start and whatever
+// stderr is (logs, tests); its final line always.
+bool ProgressForced() {
+    const char* env = std::getenv("ATMOS_PROGRESS");
+    return env != nullptr && std::strcmp(env, "1") == 0;
+}
+
 }  // namespace
 
 bool LibraryProgressEnabled() { return g_library_progress.load(std::memory_order_relaxed); }
@@ -24,12 +34,13 @@ LibraryProgressScope::~LibraryProgressScope() { g_library_progress.store(previou
 Progress::Progress(std::string label, int64_t total, bool enabled)
     : label_(std::move(label)),
       total_(total > 0 ? total : 1),
-      active_(enabled && isatty(STDERR_FILENO) != 0),
+      active_(enabled && (isatty(STDERR_FILENO) != 0 || ProgressForced())),
+      forced_(enabled && ProgressForced()),
       start_(std::chrono::steady_clock::now()),
       last_draw_(start_) {}
 
 Progress::~Progress() {
-    if (drawn_) Draw(true);
+    if (drawn_ || forced_) Draw(true);
 }
 
 std::string Progress::FormatDuration(double seconds) {
@@ -55,7 +66,7 @@ void Progress::Add(int64_t done) {
     const auto now = std::chrono::steady_clock::now();
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     const double since_draw = std::chrono::duration<double>(now - last_draw_).count();
-    if (elapsed < kQuietSeconds || since_draw < kRedrawSeconds) return;
+    if ((elapsed < kQuietSeconds && !forced_) || since_draw < kRedrawSeconds) return;
     last_draw_ = now;
     Draw(false);
 }

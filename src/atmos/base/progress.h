@@ -1,8 +1,10 @@
 // atmos: a progress bar with ETA on stderr for long work.
 //
 // Silent when disabled (--quiet), when stderr is not a terminal, and for work
-// that finishes within about a second. Thread-safe: Add() may be called from
-// worker threads.
+// that finishes within about a second; the environment variable
+// ATMOS_PROGRESS=1 draws every enabled bar anyway (from the start, whatever
+// stderr is, always with its final line: logs and tests). Thread-safe: Add()
+// may be called from worker threads.
 #pragma once
 
 #include <atomic>
@@ -33,6 +35,7 @@ class Progress {
     std::string label_;
     int64_t total_;
     bool active_;
+    bool forced_;  // ATMOS_PROGRESS=1
     bool drawn_ = false;
     std::atomic<int64_t> done_{0};
     std::chrono::steady_clock::time_point start_;

@@ -15,6 +15,7 @@
 #include "harness/render_cache.h"
 #include "harness/report.h"
 #include "harness/spectral_run.h"
+#include "io/output_path.h"
 #include "metrics/rmse.h"
 
 namespace fs = std::filesystem;
@@ -212,8 +213,7 @@ void WriteMetricCsv(const std::string& path, const std::string& corner,
                     const std::vector<std::string>& columns,
                     const std::vector<std::vector<double>>& values,
                     const std::vector<double>& row_noise) {
-    std::ofstream f(path);
-    if (!f) Fail("cannot write '", path, "'");
+    TextOutput f(path);
     f << corner;
     for (const std::string& c : columns) f << "," << c;
     f << ",best\n";
@@ -231,7 +231,7 @@ void WriteMetricCsv(const std::string& path, const std::string& corner,
         }
         f << "," << best << "\n";
     }
-    if (!f) Fail("cannot write '", path, "'");
+    f.Commit();
 }
 
 CompareResult RunCompare(const CompareConfig& config) {
@@ -466,15 +466,16 @@ CompareResult RunCompare(const CompareConfig& config) {
     WriteMetricCsv((out / "rmse.csv").string(), "RMSE errors", labels, result.models, rmses,
                    rmse_noise);
     if (split_reference || noise_target) {
-        std::ofstream f(out / "reference_noise.csv");
+        TextOutput f((out / "reference_noise.csv").string());
         f << "view,reference_noise_flip,half_spp,noise_target\n";
         for (const CompareRow& row : result.rows) {
             f << row.view << "," << row.reference_noise << "," << row.reference_spp / 2 << ","
               << (noise_target ? mc.noise_target : 0.0) << "\n";
         }
+        f.Commit();
     }
     {
-        std::ofstream f(out / "times.csv");
+        TextOutput f((out / "times.csv").string());
         f << "view,model,render_seconds,cached,prepare_seconds\n";
         for (const CompareRow& row : result.rows) {
             f << row.view << ",reference:" << config.reference_model << "," << row.reference_seconds
@@ -486,6 +487,7 @@ CompareResult RunCompare(const CompareConfig& config) {
                   << "\n";
             }
         }
+        f.Commit();
     }
     result.total_seconds = SecondsSince(start);
     WriteAccuracyCostCsv((out / "accuracy_cost.csv").string(), config, result);

@@ -6,13 +6,13 @@
 #include <fstream>
 
 #include "atmos/error.h"
+#include "io/output_path.h"
 
 namespace atmos {
 
 void WriteGalleryHtml(const std::string& path, const std::string& title,
                       const std::string& subtitle, const std::vector<GalleryEntry>& entries) {
-    std::ofstream f(path);
-    if (!f) Fail("cannot write '", path, "'");
+    TextOutput f(path);
     f << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>"
       << HtmlEscape(title) << "</title>\n<style>\n"
       << "body{font-family:sans-serif;background:#111;color:#ddd;margin:2em}\n"
@@ -34,7 +34,7 @@ void WriteGalleryHtml(const std::string& path, const std::string& title,
         f << "</figcaption></figure>\n";
     }
     f << "</div>\n</body></html>\n";
-    if (!f) Fail("cannot write '", path, "'");
+    f.Commit();
 }
 
 }  // namespace atmos

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "atmos/error.h"
+#include "io/output_path.h"
 
 namespace fs = std::filesystem;
 
@@ -129,9 +130,7 @@ void RenderCache::Store(const RenderKey& key, const Image& image, double render_
         WriteImage(*variance, exr.substr(0, exr.size() - 4) + ".variance.exr");
         j["variance"] = true;
     }
-    std::ofstream f(meta);
-    f << j.dump(1) << "\n";
-    if (!f) Fail("cannot write '", meta, "'");
+    WriteFileAtomically(meta, j.dump(1) + "\n");
 }
 
 namespace {
@@ -174,9 +173,7 @@ void RenderCache::StorePrepare(const RenderKey& key, double seconds, int64_t tab
     j["prepare_seconds"] = seconds;
     j["table_bytes"] = table_bytes;
     const std::string path = PreparePath(directory_, key);
-    std::ofstream f(path);
-    f << j.dump(1) << "\n";
-    if (!f) Fail("cannot write '", path, "'");
+    WriteFileAtomically(path, j.dump(1) + "\n");
 }
 
 }  // namespace atmos

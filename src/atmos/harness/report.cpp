@@ -13,6 +13,7 @@
 #include "harness/machine.h"
 #include "harness/ranking.h"
 #include "harness/svg.h"
+#include "io/output_path.h"
 #include "metrics/flip.h"
 
 namespace atmos {
@@ -465,8 +466,7 @@ void ProfilePlot(std::ostream& f, const CompareRow& row, const CompareRow::Profi
 
 void WriteCompareReport(const std::string& path, const CompareConfig& config,
                         const CompareResult& r) {
-    std::ofstream f(path);
-    if (!f) Fail("cannot write '", path, "'");
+    TextOutput f(path);
     const bool transmittance = config.quantity == Quantity::kTransmittance;
     const std::string title =
         std::string("atmos compare: ") + (transmittance ? "transmittance" : "radiance");
@@ -674,7 +674,7 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
          "  if (bad.length) p.textContent = 'images that did not load: ' + bad.join(', ');\n"
          "});\n</script>\n";
     f << "</body></html>\n";
-    if (!f) Fail("cannot write '", path, "'");
+    f.Commit();
 }
 
 double MeanReferenceNoise(const CompareResult& r) {
@@ -739,8 +739,7 @@ std::vector<CompareSummary> SummarizeCompare(const CompareConfig& config, const 
 
 void WriteAccuracyCostCsv(const std::string& path, const CompareConfig& config,
                           const CompareResult& result) {
-    std::ofstream f(path);
-    if (!f) Fail("cannot write '", path, "'");
+    TextOutput f(path);
     f << "model,mean_flip,worst_flip,worst_view,unresolved_views,frame_seconds,"
          "frame_seconds_1920x1080,prepare_seconds,table_bytes,lines_of_code,rank,pareto,"
          "validity\n";
@@ -751,7 +750,7 @@ void WriteAccuracyCostCsv(const std::string& path, const CompareConfig& config,
           << s.table_bytes << "," << s.lines << "," << s.rank << "," << (s.pareto ? 1 : 0) << ",\""
           << s.validity << "\"\n";
     }
-    if (!f) Fail("cannot write '", path, "'");
+    f.Commit();
 }
 
 }  // namespace atmos

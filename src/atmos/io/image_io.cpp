@@ -69,16 +69,9 @@ void WriteImage(const Image& image, const std::string& path, float exposure) {
         Fail("cannot write '", path, "': the image holds ", image.size(), " floats, expected ",
              image.width(), "x", image.height(), "x3");
     }
-    if (std::filesystem::is_directory(path)) Fail("cannot write '", path, "': it is a directory");
     // Every format through a temporary file beside the target and one rename:
     // a failed write (a full disk) leaves no truncated file under `path`.
-    const std::filesystem::path target(path);
-    const std::string temporary =
-        (target.parent_path() /
-         ("." + target.filename().string() + ".tmp-" +
-          std::to_string(static_cast<long>(::getpid())) + target.extension().string()))
-            .string();
-    try {
+    WriteThroughTemporary(path, [&](const std::string& temporary) {
         switch (format) {
             case ImageFormat::kExr:
                 detail::WriteExr(image, temporary);
@@ -93,6 +86,20 @@ void WriteImage(const Image& image, const std::string& path, float exposure) {
                 detail::WritePfm(image, temporary);
                 break;
         }
+    });
+}
+
+void WriteThroughTemporary(const std::string& path,
+                           const std::function<void(const std::string& temporary)>& write) {
+    if (std::filesystem::is_directory(path)) Fail("cannot write '", path, "': it is a directory");
+    const std::filesystem::path target(path);
+    const std::string temporary =
+        (target.parent_path() /
+         ("." + target.filename().string() + ".tmp-" +
+          std::to_string(static_cast<long>(::getpid())) + target.extension().string()))
+            .string();
+    try {
+        write(temporary);
         std::error_code ec;
         std::filesystem::rename(temporary, target, ec);
         if (ec) Fail("cannot write '", path, "': ", ec.message());
@@ -111,6 +118,19 @@ void WriteImage(const Image& image, const std::string& path, float exposure) {
         std::filesystem::remove(temporary, ignored);
         throw;
     }
+}
+
+void WriteFileAtomically(const std::string& path, const std::string& bytes) {
+    WriteThroughTemporary(path, [&](const std::string& temporary) {
+        FilePtr f(std::fopen(temporary.c_str(), "wb"));
+        if (!f) Fail("cannot write '", temporary, "': ", std::strerror(errno));
+        const bool written = std::fwrite(bytes.data(), 1, bytes.size(), f.get()) == bytes.size() &&
+                             std::fflush(f.get()) == 0;
+        const int err = errno;
+        if (std::fclose(f.release()) != 0 || !written) {
+            Fail("cannot write '", temporary, "': ", std::strerror(written ? errno : err));
+        }
+    });
 }
 
 namespace {

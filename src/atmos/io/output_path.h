@@ -7,6 +7,8 @@
 // (a full disk) never leaves a truncated file under the final name.
 #pragma once
 
+#include <functional>
+#include <sstream>
 #include <string>
 
 namespace atmos {
@@ -19,5 +21,27 @@ void CheckOutputFile(const std::string& path);
 // existing ancestor is a writable directory; nothing is created here).
 // Throws atmos::Error naming the path and the reason.
 void CheckOutputDirectory(const std::string& path);
+
+// Writes `path` through a temporary file beside it (".NAME.tmp-PID.EXT") and
+// one rename: `write` writes the file it is given and throws on failure; a
+// failure removes the temporary and throws atmos::Error naming `path`, and
+// leaves any previous file at `path` as it was. Every output of the CLI goes
+// through it (images: WriteImage; text: WriteFileAtomically, TextOutput).
+void WriteThroughTemporary(const std::string& path,
+                           const std::function<void(const std::string& temporary)>& write);
+// `bytes` to `path` that way (each write and the close checked).
+void WriteFileAtomically(const std::string& path, const std::string& bytes);
+
+// A text output (CSV, HTML, JSON) built in memory and written by Commit()
+// through WriteFileAtomically: a failure never leaves a truncated file.
+class TextOutput : public std::ostringstream {
+  public:
+    explicit TextOutput(std::string path) : path_(std::move(path)) {}
+    const std::string& path() const { return path_; }
+    void Commit() const { WriteFileAtomically(path_, str()); }
+
+  private:
+    std::string path_;
+};
 
 }  // namespace atmos

@@ -241,6 +241,8 @@ std::vector<SampleAnswer> HillaireModel::Sample(const std::vector<SampleQuery>& 
     StageSession session;
     Table sky_view;
     std::vector<SampleQuery> group_queries;
+    // One bar for every group (a sky-view table and its queries each).
+    Progress progress("sample", static_cast<int64_t>(queries.size()), LibraryProgressEnabled());
     for (const auto& group : groups) {
         const double r = atm.bottom_radius + group.first.first;
         HillaireEvaluator e = evaluator_;
@@ -253,7 +255,7 @@ std::vector<SampleAnswer> HillaireModel::Sample(const std::vector<SampleQuery>& 
         group_queries.clear();
         for (size_t q : members) group_queries.push_back(queries[q]);
         const std::vector<SampleAnswer> group_answers =
-            SampleAll(e, atm.bottom_radius, group_queries);
+            SampleAll(e, atm.bottom_radius, group_queries, &progress);
         for (size_t k = 0; k < members.size(); ++k) answers[members[k]] = group_answers[k];
     }
     return answers;

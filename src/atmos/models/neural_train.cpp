@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "atmos/error.h"
+#include "base/library_progress.h"
+#include "base/progress.h"
 #include "base/rng.h"
 #include "render/progressive.h"
 
@@ -141,7 +143,7 @@ double SampleLoss(const double* y_hat, const double* y, double eps, double* d_ou
 
 // Adam (Kingma & Ba 2015, Algorithm 1) on mini-batches of `train`.
 void Train(Mlp* net, const DataSet& train, int steps, double final_lr, const NeuralFitOptions& o,
-           uint64_t stream, NeuralNetFitReport* report) {
+           uint64_t stream, NeuralNetFitReport* report, Progress* progress) {
     const double beta1 = 0.9, beta2 = 0.999, adam_eps = 1e-8;
     std::vector<double> mw(net->w.size(), 0.0), vw(net->w.size(), 0.0);
     std::vector<double> mb(net->b.size(), 0.0), vb(net->b.size(), 0.0);
@@ -168,6 +170,7 @@ void Train(Mlp* net, const DataSet& train, int steps, double final_lr, const Neu
         }
         loss_acc += batch_loss / o.batch;
         ++loss_count;
+        progress->Add(1);
         if ((step + 1) % report_every == 0) {
             report->loss.push_back(loss_acc / loss_count);
             loss_acc = 0.0;
@@ -234,7 +237,7 @@ void Split(const DataSet& all, double holdout, DataSet* train, DataSet* test) {
 }
 
 NeuralNetFitReport FitOne(Mlp* net, const DataSet& all, int steps, double final_lr,
-                          const NeuralFitOptions& o, uint64_t stream) {
+                          const NeuralFitOptions& o, uint64_t stream, Progress* progress) {
     DataSet train, test;
     Split(all, o.holdout, &train, &test);
     if (train.Size() == 0) Fail("fit: no training samples");
@@ -247,7 +250,7 @@ NeuralNetFitReport FitOne(Mlp* net, const DataSet& all, int steps, double final_
         for (int c = 0; c < 3; ++c) net->b[net->b.size() - 3 + static_cast<size_t>(c)] = -mean;
     }
     NeuralNetFitReport r;
-    Train(net, train, steps, final_lr, o, stream, &r);
+    Train(net, train, steps, final_lr, o, stream, &r, progress);
     Errors(*net, train, &r.train_rms_log, nullptr);
     Errors(*net, test, &r.holdout_rms_log, &r.holdout_rel_mean);
     return r;
@@ -400,8 +403,11 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     NeuralFitReport r;
     // The step decay is the scattering network's only (issue 15: it made the
     // transmittance network worse, held-out 0.222 against 0.199).
-    r.transmittance = FitOne(&tnet, td, o.transmittance_steps, o.learning_rate, o, 0x71);
-    r.scattering = FitOne(&snet, sd, o.scattering_steps, o.final_learning_rate, o, 0x53);
+    // The training's steps as a progress bar (the CLI's `fit`; base/library_progress.h).
+    Progress progress("fit: training", int64_t{o.transmittance_steps} + o.scattering_steps,
+                      LibraryProgressEnabled());
+    r.transmittance = FitOne(&tnet, td, o.transmittance_steps, o.learning_rate, o, 0x71, &progress);
+    r.scattering = FitOne(&snet, sd, o.scattering_steps, o.final_learning_rate, o, 0x53, &progress);
     const auto t2 = std::chrono::steady_clock::now();
     r.sample_seconds = std::chrono::duration<double>(t1 - t0).count();
     r.train_seconds = std::chrono::duration<double>(t2 - t1).count();

@@ -290,8 +290,10 @@ std::string ReferenceModel::PassKey() const {
 
 void ReferenceModel::RenderPass(const RenderRequest& request, const MonteCarloPass& pass,
                                 Image* out, Progress* progress) const {
-    const PixelSetup setup = MakePixelSetup(request, evaluator_.atm);
-    out->Resize(request.width, request.height);
+    PixelSetup setup = MakePixelSetup(request, evaluator_.atm);
+    // The pass's band of rows (checkpoints may fall between bands).
+    setup.first_row = pass.row_begin;
+    out->Resize(request.width, pass.rows > 0 ? pass.rows : request.height - pass.row_begin);
     ReferenceEvaluator e = evaluator();
     e.seed = pass.seed;
     if (request.quantity == Quantity::kTransmittance) {
@@ -347,6 +349,7 @@ std::shared_ptr<const Table> ReferenceModel::Order1Table(const PixelSetup& setup
         PixelSetup unit = setup;
         unit.irradiance = Rgb(1.0f);  // sky + ground per unit irradiance
         unit.sun_disc = false;
+        unit.first_row = 0;  // the whole image, whatever band the pass renders
         Image image;
         image.Resize(setup.width, setup.height);
         RenderImage(first, unit, image.View(), nullptr);

@@ -314,22 +314,32 @@ struct ReferenceEvaluator {
     // ray meets the ground), per channel; unbiased.
     //
     // With a majorant k times the extinction, the estimate's relative variance
-    // in a homogeneous medium is exp(tau / k) - 1 (Novak et al. 2014), at a
-    // cost of ~k tau_bar steps: a tight majorant (k = 1) is noisy in deep shadow
-    // (tau = 14: 1e6) and still 35 % at tau = 0.3. So the majorants are scaled
-    // by k chosen from tau_bar, the ray's majorant optical depth (computed
-    // exactly by walking the shells):
+    // in a homogeneous medium is exp(tau / k) - 1 (Novak et al. 2014), its
+    // second moment T^2 exp(tau / k) = exp(-tau (2 - 1/k)), at a cost of
+    // ~k tau_bar steps: a tight majorant (k = 1) is noisy relative to T in
+    // deep shadow (tau = 14: 1e6) and still 35 % at tau = 0.3. So the
+    // majorants are scaled by k chosen from tau_bar, the ray's majorant
+    // optical depth (computed exactly by walking the shells):
     //   tau_bar <= 1.77: k = max(1, 20 tau_bar): relative variance <= 5 %, <= 64 steps;
-    //   1.77 .. 8:       k = 64 / tau_bar:        <= e - 1, 64 steps;
-    //   > 8:             k = tau_bar:             <= e - 1, tau_bar^2 steps
-    // (only deep-shadow rays, whose transmittance is below 3e-4, cost more).
+    //   1.77 .. 8:       k = 64 / tau_bar:       <= e - 1, 64 steps;
+    //   8 .. 32:         k = tau_bar:            <= e - 1, tau_bar^2 <= 1024 steps;
+    //   > 32:            k = max(1, 1024 / tau_bar): max(1024, tau_bar) steps.
+    // Beyond 32 (deep shadow: T = exp(-32) = 1.3e-14 where the majorant is
+    // tight) the relative variance grows (exp(tau tau_bar / 1024) - 1) but the second moment stays
+    // below exp(-tau); the cost per shadow ray is at most max(1024, tau_bar) steps, linear in the
+    // optical depth (issue 18 item 9: k = tau_bar without the cap cost tau_bar^2 steps, 7.3e5 for a
+    // horizontal ray near the ground of a dense layer, and a 64x36 image was projected at hours).
+    // Unbiased for any k >= 1.
     ATMOS_HD static double RatioTrackingScale(double tau_bar) {
         if (tau_bar <= 1.77) return Max(1.0, 20.0 * tau_bar);
         if (tau_bar <= 8.0) return 64.0 / tau_bar;
-        return tau_bar;
+        if (tau_bar <= 32.0) return tau_bar;
+        return Max(1.0, 1024.0 / tau_bar);
     }
 
-    ATMOS_HD Vec3d RatioTracking(Vec3d p, const Vec3d& dir, int shell, Rng& rng) const {
+    // `steps` (optional) counts the tentative collisions (tests: the cost).
+    ATMOS_HD Vec3d RatioTracking(Vec3d p, const Vec3d& dir, int shell, Rng& rng,
+                                 int64_t* steps = nullptr) const {
         const double r = Length(p);
         if (RayIntersectsGround(r, ClampCosine(Dot(p, dir) / r), atm.bottom_radius)) {
             return Vec3d(0.0);
@@ -340,6 +350,7 @@ struct ReferenceEvaluator {
             const Step step = Track(&p, dir, &shell, rng, k);
             if (step == Step::kEscaped) return t;
             if (step == Step::kGround) return Vec3d(0.0);
+            if (steps) ++*steps;
             const Densities d = GetDensities(atm, Length(p) - atm.bottom_radius);
             const Vec3d sigma_t = Extinction(atm, d);
             t = t * (Vec3d(1.0) - sigma_t / (k * shells.majorant[shell]));

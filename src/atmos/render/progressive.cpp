@@ -41,6 +41,12 @@ void CheckSettings(const MonteCarloSettings& mc) {
         Fail("Monte Carlo render: the noise target must be in (0, 1) (0: off), got ",
              mc.noise_target);
     }
+    if (!(mc.checkpoint_seconds >= 0.0) || !std::isfinite(mc.checkpoint_seconds)) {
+        Fail(
+            "Monte Carlo render: the checkpoint interval must be a finite number of seconds >= "
+            "0, got ",
+            mc.checkpoint_seconds);
+    }
 }
 
 // Everything that determines a render's passes; a checkpoint resumes only the
@@ -73,9 +79,12 @@ nlohmann::json CheckpointKey(const Model& model, const RenderRequest& request, i
 // STEM.bin.tmp, fsync'ed, renamed over STEM.bin, its directory fsync'ed. A kill
 // at any point leaves the previous checkpoint (or none) intact. Layout (host
 // byte order): the 8 bytes "atmosck2", the header's length (uint64), the
-// header (JSON: the render's key, width, height, passes_done, samples_done),
-// the sums and the sums of squares (float32, width x height x 3 each), and a
-// 64-bit FNV-1a checksum of everything before it.
+// header (JSON: the render's key, width, height, passes_done, samples_done,
+// and for a checkpoint inside a pass rows_done and pass_samples: that pass's
+// rows [0, rows_done) of pass_samples samples are in the sums too), the sums
+// and the sums of squares (float32, width x height x 3 each; a noise-targeted
+// render also the even passes' sum), and a 64-bit FNV-1a checksum of
+// everything before it.
 constexpr char kCheckpointMagic[8] = {'a', 't', 'm', 'o', 's', 'c', 'k', '2'};
 
 uint64_t Fnv1a(const char* data, size_t size, uint64_t h = 14695981039346656037ull) {
@@ -89,6 +98,10 @@ uint64_t Fnv1a(const char* data, size_t size, uint64_t h = 14695981039346656037u
 struct CheckpointState {
     int64_t passes_done = 0;
     int64_t samples_done = 0;
+    // Inside pass passes_done: its rows [0, rows_done), of pass_samples samples
+    // each, are in the sums (0, 0: between passes).
+    int rows_done = 0;
+    int64_t pass_samples = 0;
     Image sum, sum_sq;
     Image sum_even;  // the even passes' sum (noise-targeted renders only; else empty)
 };
@@ -115,6 +128,8 @@ void WriteCheckpoint(const std::string& path, const nlohmann::json& key,
     header["height"] = state.sum.height();
     header["passes_done"] = state.passes_done;
     header["samples_done"] = state.samples_done;
+    header["rows_done"] = state.rows_done;
+    header["pass_samples"] = state.pass_samples;
     header["even_sum"] = state.sum_even.size() > 0;
     const std::string text = header.dump();
     const uint64_t header_size = text.size();
@@ -190,6 +205,8 @@ CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& ke
         }
         s.passes_done = header.at("passes_done").get<int64_t>();
         s.samples_done = header.at("samples_done").get<int64_t>();
+        s.rows_done = header.value("rows_done", 0);
+        s.pass_samples = header.value("pass_samples", int64_t{0});
     } catch (const nlohmann::json::exception&) {
         damaged("header fields missing");
     }
@@ -202,8 +219,13 @@ CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& ke
                            s.samples_done <= s.passes_done * pass_spp &&
                            (s.passes_done == 0 || s.samples_done > (s.passes_done - 1) * pass_spp);
     if (!counts_ok) damaged("its pass and sample counts disagree");
-    if (s.samples_done > spp) {
-        Fail("checkpoint '", path, "' already holds ", s.samples_done,
+    // Inside a pass: a band of rows of a pass of 1 to pass_spp samples.
+    const bool band_ok = s.rows_done == 0 ? s.pass_samples == 0
+                                          : s.rows_done < height && s.rows_done > 0 &&
+                                                s.pass_samples >= 1 && s.pass_samples <= pass_spp;
+    if (!band_ok) damaged("its row and pass counts disagree");
+    if (s.samples_done + s.pass_samples > spp) {
+        Fail("checkpoint '", path, "' already holds ", s.samples_done + s.pass_samples,
              " samples per pixel, more than --spp ", spp);
     }
     s.sum.Resize(width, height);
@@ -222,7 +244,6 @@ CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& ke
             damaged("a sum is not finite");
         }
     }
-    if (halves && s.passes_done % 2 != 0) damaged("a noise-targeted render ends on an odd pass");
     return s;
 }
 
@@ -353,10 +374,10 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     };
 
     const int64_t pixels = static_cast<int64_t>(request.width) * request.height;
-    Progress progress(model.Info().name, pixels * std::max<int64_t>(passes - passes_done, 1),
+    Progress progress(model.Info().name,
+                      pixels * std::max<int64_t>(passes - passes_done, 1) -
+                          static_cast<int64_t>(state.rows_done) * request.width,
                       request.show_progress);
-    Image pass_image;
-    auto last_save = std::chrono::steady_clock::now();
     const StopSignalScope stop(!stem.empty());
     // A noise target: the halves' FLIP after pairs of passes, at sample counts
     // growing geometrically (or as FLIP ~ spp^-0.45 predicts, at most x3).
@@ -383,32 +404,93 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
         return noise <= mc.noise_target;
     };
     bool reached = false;
-    if (noise_mode && passes_done >= 2) reached = measure_noise();
+    // A resumed noise-targeted render between two pairs of passes.
+    if (noise_mode && passes_done >= 2 && passes_done % 2 == 0 && state.rows_done == 0) {
+        reached = measure_noise();
+    }
+    // Each pass is rendered in bands of rows (issue 18 item 10) so that a
+    // checkpoint, at most every checkpoint_seconds, and a stop on SIGINT or
+    // SIGTERM can fall inside a pass: bands of about a second (the measured
+    // rate; one row when checkpoint_seconds is 0), the whole image when
+    // nothing is checkpointed. Pixels depend on their coordinates only, so the
+    // bands do not change the image.
+    using Clock = std::chrono::steady_clock;
+    const double band_seconds = std::min(1.0, mc.checkpoint_seconds / 2.0);
+    const int width = request.width;
+    const int height = request.height;
+    int band_rows = stem.empty()          ? height
+                    : band_seconds <= 0.0 ? 1
+                                          : std::clamp(16384 / std::max(width, 1), 1, height);
+    auto last_save = Clock::now();
+    Image band_image;
     for (int64_t p = passes_done; p < passes && !reached; ++p) {
         MonteCarloPass pass;
         pass.seed = mc.seed;
         pass.first_sample = p * pass_spp;
-        pass.samples = noise_mode ? pass_spp : std::min(pass_spp, spp - pass.first_sample);
-        model.RenderPass(request, pass, &pass_image, &progress);
+        pass.samples = state.rows_done > 0 ? state.pass_samples  // a resumed pass
+                       : noise_mode        ? pass_spp
+                                           : std::min(pass_spp, spp - pass.first_sample);
         // Weighted by the pass's sample count so a short last pass counts right.
         const float wgt = static_cast<float>(pass.samples);
-        for (size_t i = 0; i < n; ++i) {
-            const float v = pass_image.data()[i];
-            sum.data()[i] += wgt * v;
-            sum_sq.data()[i] += wgt * v * v;
-            if (noise_mode && p % 2 == 0) state.sum_even.data()[i] += wgt * v;
+        int signal_number = 0;
+        for (int row = state.rows_done; row < height;) {
+            pass.row_begin = row;
+            pass.rows = std::min(band_rows, height - row);
+            const auto band_start = Clock::now();
+            model.RenderPass(request, pass, &band_image, &progress);
+            if (band_image.width() != width || band_image.height() != pass.rows) {
+                Fail("model ", model.Info().name, " rendered ", band_image.width(), "x",
+                     band_image.height(), " pixels for a band of ", width, "x", pass.rows,
+                     " (Model::RenderPass renders the pass's band of rows)");
+            }
+            const size_t first = static_cast<size_t>(row) * static_cast<size_t>(width) * 3;
+            const size_t count = static_cast<size_t>(pass.rows) * static_cast<size_t>(width) * 3;
+            for (size_t j = 0; j < count; ++j) {
+                const size_t i = first + j;
+                const float v = band_image.data()[j];
+                sum.data()[i] += wgt * v;
+                sum_sq.data()[i] += wgt * v * v;
+                if (noise_mode && p % 2 == 0) state.sum_even.data()[i] += wgt * v;
+            }
+            row += pass.rows;
+            const auto now = Clock::now();
+            if (!stem.empty()) {
+                const double took = std::chrono::duration<double>(now - band_start).count();
+                const double per_row = took / pass.rows;
+                band_rows = per_row > 0.0
+                                ? static_cast<int>(std::clamp(band_seconds / per_row, 1.0,
+                                                              static_cast<double>(height)))
+                                : height;
+            }
+            if (row == height) break;  // the pass's end: below
+            state.rows_done = row;
+            state.pass_samples = pass.samples;
+            signal_number = stop.Received();
+            if (signal_number != 0 ||
+                std::chrono::duration<double>(now - last_save).count() >= mc.checkpoint_seconds) {
+                save_checkpoint();
+                last_save = Clock::now();
+            }
+            if (signal_number != 0) {
+                Fail("interrupted by ", signal_number == SIGINT ? "SIGINT" : "SIGTERM", " in pass ",
+                     p + 1, " of ", passes, " (", samples_done, " of ", spp,
+                     " samples per pixel and ", row, " of ", height,
+                     " rows of the next pass done); the checkpoint '", path,
+                     "' holds them: the same command with --resume continues");
+            }
         }
+        state.rows_done = 0;
+        state.pass_samples = 0;
         ++passes_done;
         samples_done += pass.samples;
         const bool pair_done = !noise_mode || p % 2 == 1;
         if (noise_mode && pair_done && (samples_done >= next_check || p + 1 == passes)) {
             reached = measure_noise();
         }
-        const auto now = std::chrono::steady_clock::now();
-        const int signal_number = stop.Received();
-        if (signal_number != 0 ||
-            (pair_done && (std::chrono::duration<double>(now - last_save).count() > 10.0 ||
-                           p + 1 == passes || reached))) {
+        const auto now = Clock::now();
+        signal_number = stop.Received();
+        if (signal_number != 0 || p + 1 == passes || reached ||
+            std::chrono::duration<double>(now - last_save).count() >= mc.checkpoint_seconds) {
             save_checkpoint();
             last_save = now;
         }

@@ -47,4 +47,9 @@ void FailNoDeviceKernels(const char* evaluator) {
          " has no device kernels (its model is not in src/atmos/models/model_list.h)");
 }
 
+void FailBadBand(int width, int height, int first_row, int band_width, int band_rows) {
+    Fail("render: a band of ", band_width, "x", band_rows, " pixels from row ", first_row,
+         " does not fit a ", width, "x", height, " image");
+}
+
 }  // namespace atmos

@@ -39,7 +39,8 @@ struct PixelSetup {
     Vec3d sun_direction;
     Rgb irradiance;  // view irradiance x atmosphere solar irradiance
     int width = 0;
-    int height = 0;
+    int height = 0;              // the camera's image; a render may cover a band of its rows
+    int first_row = 0;           // the band's first row (RenderImage: `out` holds the band)
     bool transmittance = false;  // output the transmittance instead of radiance
     bool sun_disc = false;
     double cos_sun_radius = 1.0;  // cos(sun angular radius)
@@ -92,6 +93,8 @@ int64_t GuardOutput(float* values, size_t count);
 // Throws the error of a device launch that cannot run: an evaluator without
 // device kernels (not in models/model_list.h; render/render.cpp).
 [[noreturn]] void FailNoDeviceKernels(const char* evaluator);
+// Throws the error of a band of rows outside the image (RenderImage).
+[[noreturn]] void FailBadBand(int width, int height, int first_row, int band_width, int band_rows);
 // True for the evaluators of models/model_list.h (defined from the list in
 // models/registry.cpp): the ones the CUDA build has kernels for.
 bool HasDeviceKernels(const std::type_info& evaluator);
@@ -101,7 +104,7 @@ template <typename Evaluator>
 struct RenderStage {
     Evaluator evaluator;
     PixelSetup setup;
-    TableOut out;  // the image: width x height x 3, written whole
+    TableOut out;  // the band of rows [first_row, first_row + out.height): width x rows x 3
     // Its output and any id-0 view are copied back and dropped from the
     // session after the launch (render/stages.h).
     static constexpr bool kTransient = true;
@@ -112,9 +115,9 @@ struct RenderStage {
     }
     ATMOS_HD void operator()(int64_t item) const {
         const int x = static_cast<int>(item % setup.width);
-        const int y = static_cast<int>(item / setup.width);
-        const ImageView image{out.data, setup.width, setup.height};
-        image.Set(x, y, ShadePixel(evaluator, setup, x, y));
+        const int row = static_cast<int>(item / setup.width);
+        const ImageView image{out.data, setup.width, out.height};
+        image.Set(x, row, ShadePixel(evaluator, setup, x, setup.first_row + row));
     }
 };
 
@@ -150,10 +153,11 @@ struct HasDeviceStage<RenderStage<E>> : std::bool_constant<!IsHostOnly<E>::value
 template <typename E>
 struct HasDeviceStage<SampleStage<E>> : std::bool_constant<!IsHostOnly<E>::value> {};
 
-// Renders every pixel of `out` (already sized s.width x s.height) through
+// Renders every pixel of `out` (already sized s.width x rows: the image's rows
+// [s.first_row, s.first_row + rows), all of them by default) through
 // RunStage("render", ...): each pixel depends on its coordinates only, so the
-// image is the same for any backend schedule and thread count. `progress`
-// (may be null) is advanced by one per pixel.
+// image is the same for any backend schedule, thread count and split into
+// bands. `progress` (may be null) is advanced by one per pixel.
 template <typename Evaluator>
 void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView out,
                  Progress* progress) {
@@ -166,7 +170,11 @@ void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView 
     stage.out.width = out.width;
     stage.out.height = out.height;
     stage.out.channels = 3;
-    RunStage("render", static_cast<int64_t>(setup.width) * setup.height, 256, stage, progress);
+    if (out.width != setup.width || setup.first_row < 0 || out.height < 0 ||
+        setup.first_row + out.height > setup.height) {
+        FailBadBand(setup.width, setup.height, setup.first_row, out.width, out.height);
+    }
+    RunStage("render", static_cast<int64_t>(setup.width) * out.height, 256, stage, progress);
     GuardOutput(out.data, static_cast<size_t>(out.width) * out.height * 3);
 }
 
@@ -177,10 +185,11 @@ void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView 
     RenderImage(evaluator, setup, out, &progress);
 }
 
-// Answers every query through RunStage("sample", ...).
+// Answers every query through RunStage("sample", ...), advancing `progress`
+// (may be null) by one per query.
 template <typename Evaluator>
 std::vector<SampleAnswer> SampleAll(const Evaluator& evaluator, double bottom_radius,
-                                    const std::vector<SampleQuery>& queries) {
+                                    const std::vector<SampleQuery>& queries, Progress* progress) {
     std::vector<SampleAnswer> answers(queries.size());
     if (queries.empty()) return answers;
     if (IsDeviceBackend(CurrentBackend()) && !HasDeviceKernels(typeid(Evaluator))) {
@@ -195,12 +204,18 @@ std::vector<SampleAnswer> SampleAll(const Evaluator& evaluator, double bottom_ra
     stage.answers.data = reinterpret_cast<float*>(answers.data());
     stage.answers.width = static_cast<int>(answers.size());
     stage.answers.channels = kAnswerFloats;
-    // A progress bar for long batches (the CLI's `sample`, over a second;
-    // base/library_progress.h).
-    Progress progress("sample", static_cast<int64_t>(queries.size()), LibraryProgressEnabled());
-    RunStage("sample", static_cast<int64_t>(queries.size()), 64, stage, &progress);
+    RunStage("sample", static_cast<int64_t>(queries.size()), 64, stage, progress);
     GuardOutput(reinterpret_cast<float*>(answers.data()), answers.size() * kAnswerFloats);
     return answers;
+}
+
+// The same with a progress bar of its own for long batches (the CLI's
+// `sample`, over a second; base/library_progress.h).
+template <typename Evaluator>
+std::vector<SampleAnswer> SampleAll(const Evaluator& evaluator, double bottom_radius,
+                                    const std::vector<SampleQuery>& queries) {
+    Progress progress("sample", static_cast<int64_t>(queries.size()), LibraryProgressEnabled());
+    return SampleAll(evaluator, bottom_radius, queries, &progress);
 }
 
 }  // namespace atmos
