@@ -593,6 +593,39 @@ TEST(Cli, ValidateKiderOnTwoCaptures) {
     ExpectError("validate other", "unknown data set");
 }
 
+// Issue 17 item 4: --fit fits the aerosol (here with naive, cheap, on the two test
+// captures and three bins), reports it and evaluates the models with it.
+TEST(Cli, ValidateFitsTheAerosol) {
+#ifndef ATMOS_HAVE_NLOPT
+    GTEST_SKIP() << "built without NLopt";
+#endif
+    const fs::path data = fs::path(ATMOS_SOURCE_DIR) / "tests" / "data" / "kider-2013";
+    const Result r = RunAtmos(
+        "validate kider-2013 -q --models naive --fit --fit-model naive "
+        "--fit-evaluations 12 --data " +
+        data.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    const size_t at = r.err.find("relative RMSE ");
+    ASSERT_NE(at, std::string::npos) << r.err;
+    // "relative RMSE A % (start B %)": the fit does not end worse than its start.
+    double after = 0.0, before = 0.0;
+    ASSERT_EQ(
+        std::sscanf(r.err.c_str() + at, "relative RMSE %lf %% (start %lf %%)", &after, &before), 2)
+        << r.err;
+    EXPECT_LT(after, before - 1.0) << r.err;  // naive is far too dark: beta rises
+    EXPECT_NE(r.err.find("--set mie_extinction.angstrom.beta="), std::string::npos) << r.err;
+    // The models are evaluated with the fitted atmosphere: naive's overall error
+    // is below its 48.33 % with the preset (ValidateKiderOnTwoCaptures).
+    const size_t row = r.out.find("naive,all,all,all,");
+    ASSERT_NE(row, std::string::npos) << r.out;
+    EXPECT_LT(std::stod(r.out.substr(row + 18)), 45.0) << r.out.substr(row, 80);
+    ExpectError("validate kider-2013 --fit --fit-model naive -a earth --data " + data.string(),
+                "angstrom");
+    ExpectError(
+        "validate kider-2013 --fit --fit-model naive --fit-wavelengths 450 --data " + data.string(),
+        "not a Kider bin");
+}
+
 // Issue 17: compare --wavelengths compares the spectral renders as linear sRGB.
 TEST(Cli, CompareWavelengths) {
     const fs::path out = TempDir() / "compare_spectral";
@@ -608,4 +641,43 @@ TEST(Cli, CompareWavelengths) {
         "-o " +
             out.string(),
         "per-wavelength");
+}
+
+// Issue 17 item 5: --reference-wavelengths compares RGB models with a spectral
+// reference and with the RGB one (rgb_cost.csv).
+TEST(Cli, CompareSpectralReference) {
+    const fs::path out = TempDir() / "compare_rgb_cost";
+    const Result r = RunAtmos(
+        "compare -q --no-cache --models flat,naive --reference naive --views "
+        "ground-noon,ground-sunrise "
+        "-s 8x5 -a kider-2013 --white e --reference-wavelengths 400:700:4 -o " +
+        out.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::ifstream f(out / "rgb_cost.csv");
+    std::string line;
+    std::getline(f, line);
+    EXPECT_EQ(line, "view,model,flip_spectral_reference,flip_rgb_reference,difference");
+    int rows = 0;
+    while (std::getline(f, line)) {
+        ++rows;
+        std::vector<double> v;
+        std::stringstream ss(line.substr(line.find(',', line.find(',') + 1) + 1));
+        std::string item;
+        while (std::getline(ss, item, ',')) v.push_back(std::stod(item));
+        ASSERT_EQ(v.size(), 3u) << line;
+        EXPECT_GE(v[1], 0.0) << line;
+        if (line.find(",naive,") != std::string::npos) {
+            // naive against the RGB naive reference: the same image; against the
+            // spectral one it differs.
+            EXPECT_EQ(v[1], 0.0) << line;
+            EXPECT_GT(v[0], 0.0) << line;
+        }
+    }
+    EXPECT_EQ(rows, 4);
+    EXPECT_TRUE(fs::exists(out / "images" / "ground-noon" / "reference-rgb.png"));
+    ExpectError(
+        "compare -q --no-cache --models flat --reference naive --wavelengths 400:700:4 "
+        "--reference-wavelengths 400:700:4 -o " +
+            out.string(),
+        "drop --wavelengths");
 }

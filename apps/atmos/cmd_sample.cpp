@@ -221,7 +221,8 @@ int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const S
         if (!io.output.empty() && io.output != "-") {
             Fail("--output is not supported with --wavelengths: the spectral columns go to stdout");
         }
-        return SampleSpectralCsv(common, mc, spectral.wavelengths, ReadQueries(io.input));
+        const BatchSeeds seeds = ParseBatchSeeds(spectral.batch_seeds);
+        return SampleSpectralCsv(common, mc, spectral.wavelengths, ReadQueries(io.input), seeds);
     }
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(GivenModel(common));

@@ -20,13 +20,15 @@
 namespace atmos::cli {
 
 int SampleSpectralCsv(const CommonOptions& common, const MonteCarloSettings& monte_carlo,
-                      const std::string& wavelengths, const std::vector<SampleQuery>& queries) {
+                      const std::string& wavelengths, const std::vector<SampleQuery>& queries,
+                      BatchSeeds seeds) {
     if (!common.load.empty()) Fail("--load cannot be combined with --wavelengths");
     const std::vector<double> nm = ParseWavelengths(wavelengths);
     const SpectralAtmosphere atmosphere = LoadSpectralAtmosphere(common.atmosphere, common.sets);
     const std::vector<double> values = SampleSpectral(
         GivenModel(common), atmosphere, nm, queries, monte_carlo,
-        [&](const AtmosphereParameters& a, Model* model) { PrepareModel(common, a, model); });
+        [&](const AtmosphereParameters& a, Model* model) { PrepareModel(common, a, model); },
+        seeds);
     const std::vector<double> weights = WavelengthWeights(nm);
     std::string header = "altitude_m,mu,mu_s,azimuth_deg";
     for (double l : nm) header += ",L_" + WavelengthLabel(l);
