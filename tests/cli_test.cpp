@@ -539,6 +539,16 @@ TEST(Cli, SampleWavelengthsAddsSpectralColumns) {
     const Result list = RunAtmos("sample -m naive -a earth --wavelengths 440,550,680", in);
     ASSERT_EQ(list.status, 0) << list.err;
     EXPECT_EQ(list.out.rfind("altitude_m,mu,mu_s,azimuth_deg,L_440,L_550,L_680,X,Y,Z\n", 0), 0u);
+    // --output x.npy: (queries, wavelengths + 3) float32, the CSV's L and X, Y, Z.
+    const fs::path npy = TempDir() / "spectral_sample.npy";
+    const Result n = RunAtmos(
+        "sample -m naive -a kider-2013 --wavelengths 360:371.75:2 --output " + npy.string(), in);
+    ASSERT_EQ(n.status, 0) << n.err;
+    const atmos::detail::NpyArray array = atmos::detail::ReadNpyArray(npy.string());
+    ASSERT_EQ(array.shape, (std::vector<std::uint64_t>{1, 5}));
+    for (size_t i = 0; i < 5; ++i) {
+        EXPECT_NEAR(array.values[i], v[i + 4], 1e-6 * std::abs(v[i + 4])) << i;
+    }
     ExpectError("sample -m naive --wavelengths 700:400:3", "--wavelengths", in);
     ExpectError("sample -m preetham --wavelengths 400:700:4", "per-wavelength", in);
     ExpectError("render -m naive --wavelengths 400:700:x -o " + (TempDir() / "s.exr").string(),
