@@ -685,6 +685,9 @@ TEST(Cli, CompareSpectralReference) {
     }
     EXPECT_EQ(rows, 4);
     EXPECT_TRUE(fs::exists(out / "images" / "ground-noon" / "reference-rgb.png"));
+    // The report says the reference is spectral.
+    EXPECT_NE(Slurp(out / "index.html").find("rendered spectrally at 4 wavelengths"),
+              std::string::npos);
     ExpectError(
         "compare -q --no-cache --models flat --reference naive --wavelengths 400:700:4 "
         "--reference-wavelengths 400:700:4 -o " +

@@ -156,6 +156,12 @@ int CmdCompare(const CompareCliOptions& o) {
             config.reference_model, " is not one)");
     }
     CreateModel(config.reference_model, config.reference_options);  // validate the options
+    if (!config.reference_wavelengths.empty()) {
+        config.reference_note += "; rendered spectrally at " +
+                                 std::to_string(config.reference_wavelengths.size()) +
+                                 " wavelengths (--reference-wavelengths), the models in RGB; "
+                                 "rgb_cost.csv compares each model with the RGB reference too";
+    }
 
     CheckOutputDirectory(config.output_dir);  // after the flags, before the work (io/output_path.h)
     ThreadLimit limit(o.threads);
