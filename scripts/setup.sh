@@ -21,7 +21,7 @@ fi
 # python3-*, pybind11-dev: the Python module (import atmos, python/) and its
 # pytest suite, built for Debian's /usr/bin/python3; matplotlib: examples/.
 packages=(cmake g++ make ninja-build pkg-config libopenexr-dev libpng-dev nlohmann-json3-dev
-          libcli11-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev clang-format
+          libcli11-dev libnlopt-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev clang-format
           chromium fonts-dejavu-core
           python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib)
 missing=()

@@ -635,6 +635,16 @@ TEST(Cli, SampleWavelengthsAddsSpectralColumns) {
     const Result list = RunAtmos("sample -m naive -a earth --wavelengths 440,550,680", in);
     ASSERT_EQ(list.status, 0) << list.err;
     EXPECT_EQ(list.out.rfind("altitude_m,mu,mu_s,azimuth_deg,L_440,L_550,L_680,X,Y,Z\n", 0), 0u);
+    // --output x.npy: (queries, wavelengths + 3) float32, the CSV's L and X, Y, Z.
+    const fs::path npy = TempDir() / "spectral_sample.npy";
+    const Result n = RunAtmos(
+        "sample -m naive -a kider-2013 --wavelengths 360:371.75:2 --output " + npy.string(), in);
+    ASSERT_EQ(n.status, 0) << n.err;
+    const atmos::detail::NpyArray array = atmos::detail::ReadNpyArray(npy.string());
+    ASSERT_EQ(array.shape, (std::vector<std::uint64_t>{1, 5}));
+    for (size_t i = 0; i < 5; ++i) {
+        EXPECT_NEAR(array.values[i], v[i + 4], 1e-6 * std::abs(v[i + 4])) << i;
+    }
     ExpectError("sample -m naive --wavelengths 700:400:3", "--wavelengths", in);
     ExpectError("sample -m preetham --wavelengths 400:700:4", "per-wavelength", in);
     ExpectError("render -m naive --wavelengths 400:700:x -o " + (TempDir() / "s.exr").string(),
@@ -731,6 +741,39 @@ TEST(Cli, TextOutputsAreWrittenAtomically) {
     }
 }
 
+// Issue 17 item 4: --fit fits the aerosol (here with naive, cheap, on the two test
+// captures and three bins), reports it and evaluates the models with it.
+TEST(Cli, ValidateFitsTheAerosol) {
+#ifndef ATMOS_HAVE_NLOPT
+    GTEST_SKIP() << "built without NLopt";
+#endif
+    const fs::path data = fs::path(ATMOS_SOURCE_DIR) / "tests" / "data" / "kider-2013";
+    const Result r = RunAtmos(
+        "validate kider-2013 -q --models naive --fit --fit-model naive "
+        "--fit-evaluations 12 --data " +
+        data.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    const size_t at = r.err.find("relative RMSE ");
+    ASSERT_NE(at, std::string::npos) << r.err;
+    // "relative RMSE A % (start B %)": the fit does not end worse than its start.
+    double after = 0.0, before = 0.0;
+    ASSERT_EQ(
+        std::sscanf(r.err.c_str() + at, "relative RMSE %lf %% (start %lf %%)", &after, &before), 2)
+        << r.err;
+    EXPECT_LT(after, before - 1.0) << r.err;  // naive is far too dark: beta rises
+    EXPECT_NE(r.err.find("--set mie_extinction.angstrom.beta="), std::string::npos) << r.err;
+    // The models are evaluated with the fitted atmosphere: naive's overall error
+    // is below its 48.33 % with the preset (ValidateKiderOnTwoCaptures).
+    const size_t row = r.out.find("naive,all,all,all,");
+    ASSERT_NE(row, std::string::npos) << r.out;
+    EXPECT_LT(std::stod(r.out.substr(row + 18)), 45.0) << r.out.substr(row, 80);
+    ExpectError("validate kider-2013 --fit --fit-model naive -a earth --data " + data.string(),
+                "angstrom");
+    ExpectError(
+        "validate kider-2013 --fit --fit-model naive --fit-wavelengths 450 --data " + data.string(),
+        "not a Kider bin");
+}
+
 // Issue 17: compare --wavelengths compares the spectral renders as linear sRGB.
 TEST(Cli, CompareWavelengths) {
     const fs::path out = TempDir() / "compare_spectral";
@@ -746,4 +789,46 @@ TEST(Cli, CompareWavelengths) {
         "-o " +
             out.string(),
         "per-wavelength");
+}
+
+// Issue 17 item 5: --reference-wavelengths compares RGB models with a spectral
+// reference and with the RGB one (rgb_cost.csv).
+TEST(Cli, CompareSpectralReference) {
+    const fs::path out = TempDir() / "compare_rgb_cost";
+    const Result r = RunAtmos(
+        "compare -q --no-cache --models flat,naive --reference naive --views "
+        "ground-noon,ground-sunrise "
+        "-s 8x5 -a kider-2013 --white e --reference-wavelengths 400:700:4 -o " +
+        out.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::ifstream f(out / "rgb_cost.csv");
+    std::string line;
+    std::getline(f, line);
+    EXPECT_EQ(line, "view,model,flip_spectral_reference,flip_rgb_reference,difference");
+    int rows = 0;
+    while (std::getline(f, line)) {
+        ++rows;
+        std::vector<double> v;
+        std::stringstream ss(line.substr(line.find(',', line.find(',') + 1) + 1));
+        std::string item;
+        while (std::getline(ss, item, ',')) v.push_back(std::stod(item));
+        ASSERT_EQ(v.size(), 3u) << line;
+        EXPECT_GE(v[1], 0.0) << line;
+        if (line.find(",naive,") != std::string::npos) {
+            // naive against the RGB naive reference: the same image; against the
+            // spectral one it differs.
+            EXPECT_EQ(v[1], 0.0) << line;
+            EXPECT_GT(v[0], 0.0) << line;
+        }
+    }
+    EXPECT_EQ(rows, 4);
+    EXPECT_TRUE(fs::exists(out / "images" / "ground-noon" / "reference-rgb.png"));
+    // The report says the reference is spectral.
+    EXPECT_NE(Slurp(out / "index.html").find("rendered spectrally at 4 wavelengths"),
+              std::string::npos);
+    ExpectError(
+        "compare -q --no-cache --models flat --reference naive --wavelengths 400:700:4 "
+        "--reference-wavelengths 400:700:4 -o " +
+            out.string(),
+        "drop --wavelengths");
 }

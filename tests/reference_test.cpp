@@ -520,7 +520,7 @@ struct HybridFixture {
     // The model's defaults (ReferenceOptions) unless `options` says otherwise.
     explicit HybridFixture(const AtmosphereParameters& atm, int max_order = 0,
                            const ReferenceOptions& options = ReferenceOptions()) {
-        table = BuildSunOpticalDepthTable(atm, kSunTableMuSize, kSunTableRSize, kSunTableIntervals);
+        table = BuildSunColumnTable(atm, kSunTableMuSize, kSunTableRSize, kSunTableIntervals);
         e.atm = atm;
         e.shells = BuildMajorantShells(atm, 8);
         e.max_order = max_order;
@@ -529,9 +529,7 @@ struct HybridFixture {
         e.nee_comb = options.nee_comb;
         e.sun_lobe = options.sun_lobe;
         e.sun_lobe_g = options.sun_lobe_g;
-        e.sun_table.tau = table.view();
-        e.sun_table.bottom = atm.bottom_radius;
-        e.sun_table.top = atm.top_radius;
+        e.sun_table.Set(table.view(), atm);
         e.guide_candidates = options.guide;
         e.guide_mode = options.guide_mode;
         e.guide_everywhere = options.guide_everywhere != 0;
@@ -557,11 +555,9 @@ TEST(ReferenceHybrid, SunTableMatchesQuadrature) {
     for (const char* name : {"earth", "mars"}) {
         const AtmosphereParameters atm = LoadAtmosphere(name);
         const Table table =
-            BuildSunOpticalDepthTable(atm, kSunTableMuSize, kSunTableRSize, kSunTableIntervals);
+            BuildSunColumnTable(atm, kSunTableMuSize, kSunTableRSize, kSunTableIntervals);
         SunTransmittanceTable lut;
-        lut.tau = table.view();
-        lut.bottom = atm.bottom_radius;
-        lut.top = atm.top_radius;
+        lut.Set(table.view(), atm);
         Rng rng(1, 2, 3);
         double worst_abs = 0.0, worst_rel = 0.0;
         for (int i = 0; i < 3000; ++i) {
@@ -580,6 +576,32 @@ TEST(ReferenceHybrid, SunTableMatchesQuadrature) {
                     worst_abs, worst_rel);
         EXPECT_LE(worst_abs, 2.5e-4) << name;
         EXPECT_LE(worst_rel, 5e-3) << name;
+    }
+}
+
+TEST(ReferenceHybrid, SharedSunTableFollowsTheAtmosphere) {
+    // The sun's column table is shared by the atmospheres of one geometry (the
+    // batches of a spectral run): a model prepared after another of the same
+    // geometry but other coefficients, or of another Mie profile, still gets its
+    // own transmittance (against exact quadrature).
+    const AtmosphereParameters earth = LoadAtmosphere("earth");
+    AtmosphereParameters other = earth;
+    other.rayleigh_scattering = earth.rayleigh_scattering * 2.0;
+    other.mie_extinction = earth.mie_extinction * 3.0;
+    other.mie_scattering = earth.mie_scattering * 3.0;
+    AtmosphereParameters hazy = earth;
+    hazy.mie_density = ExponentialProfile(3000.0);
+    const AtmosphereParameters* atmospheres[3] = {&earth, &other, &hazy};
+    for (const AtmosphereParameters* atm : atmospheres) {
+        ReferenceModel model{ReferenceOptions()};
+        model.Prepare(*atm);
+        const ReferenceEvaluator& e = model.evaluator();
+        for (const double mu : {1.0, 0.3, 0.05}) {
+            const double r = atm->bottom_radius + 500.0;
+            const Vec3d want = ExactSunTransmittance(*atm, r, mu);
+            const Vec3d got = e.sun_table.Lookup(r, mu);
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 5e-3 * want[c]) << mu;
+        }
     }
 }
 

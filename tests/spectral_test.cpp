@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -136,6 +137,76 @@ TEST(Spectral, BatchesOfThreeCoverEveryWavelength) {
         EXPECT_GT(one[0], 0.0);
     }
     EXPECT_THROW(SampleSpectral(ParseModelSpec("preetham"), a, nm, queries, {}, prepare), Error);
+}
+
+TEST(Spectral, RequestsShareOnePreparePerBatch) {
+    // Two views at 4 wavelengths: two batches, so two Prepare()s for both views
+    // (not one per batch and view), and each view's values are those of its own
+    // run.
+    const SpectralAtmosphere a = LoadSpectralAtmosphere("kider-2013");
+    const AtmosphereParameters rgb = a.AtWavelengths(680, 550, 440);
+    int prepares = 0;
+    const auto prepare = [&](const AtmosphereParameters& p, Model* m) {
+        ++prepares;
+        m->Prepare(p);
+    };
+    const std::vector<double> nm = {400, 500, 600, 700};
+    std::vector<RenderRequest> requests(2);
+    const char* views[2] = {"ground-noon", "ground-sunrise"};
+    for (int v = 0; v < 2; ++v) {
+        requests[v].view = GetView(views[v], rgb);
+        requests[v].width = 12 + 4 * v;
+        requests[v].height = 7;
+        requests[v].show_progress = false;
+    }
+    std::vector<double> seconds;
+    const std::vector<SpectralImage> both =
+        RenderSpectralRequests(ParseModelSpec("naive"), a, nm, requests, prepare, &seconds);
+    EXPECT_EQ(prepares, 2);
+    ASSERT_EQ(both.size(), 2u);
+    ASSERT_EQ(seconds.size(), 2u);
+    for (int v = 0; v < 2; ++v) {
+        const SpectralImage one =
+            RenderSpectral(ParseModelSpec("naive"), a, nm, requests[v], prepare);
+        EXPECT_EQ(both[v].width, requests[v].width);
+        EXPECT_EQ(both[v].values, one.values) << views[v];
+    }
+    // Groups bound the memory of the images: 12x7x4 floats = 1344 bytes.
+    const auto groups = SpectralRequestGroups(requests, nm.size(), 2500);
+    ASSERT_EQ(groups.size(), 2u);
+    EXPECT_EQ(groups[0], std::vector<size_t>{0});
+    EXPECT_EQ(SpectralRequestGroups(requests, nm.size()).size(), 1u);
+}
+
+TEST(Spectral, BatchSeedsCorrelateOrSeparateTheBatches) {
+    // 502 and 503 nm lie in different batches but have nearly the same
+    // coefficients: with the same seed the path tracer's two values are nearly
+    // equal (the same paths), with distinct seeds they differ by the noise.
+    const SpectralAtmosphere a = LoadSpectralAtmosphere("kider-2013");
+    const auto prepare = [](const AtmosphereParameters& p, Model* m) { m->Prepare(p); };
+    const std::vector<double> nm = {500, 501, 502, 503, 504, 505};
+    std::vector<SampleQuery> queries;
+    for (int i = 0; i < 8; ++i) queries.push_back({0, 0.1 + 0.1 * i, 0.6, 30.0 * i});
+    MonteCarloSettings mc;
+    mc.spp = 2;
+    mc.pass_spp = 2;
+    double gap[2] = {0.0, 0.0};
+    for (const BatchSeeds seeds : {BatchSeeds::kSame, BatchSeeds::kDistinct}) {
+        const std::vector<double> v =
+            SampleSpectral(ParseModelSpec("reference"), a, nm, queries, mc, prepare, seeds);
+        double sum = 0.0, mean = 0.0;
+        for (size_t q = 0; q < queries.size(); ++q) {
+            sum += std::abs(v[q * 6 + 3] - v[q * 6 + 2]);
+            mean += v[q * 6 + 2];
+        }
+        gap[seeds == BatchSeeds::kDistinct] = sum / mean;
+    }
+    std::printf("relative |L(503) - L(502)|: same seeds %.4f, distinct %.4f\n", gap[0], gap[1]);
+    EXPECT_LT(gap[0], 0.02);
+    EXPECT_GT(gap[1], 0.05);
+    EXPECT_EQ(BatchSeed(7, 3, BatchSeeds::kSame), 7u);
+    EXPECT_EQ(BatchSeed(7, 3, BatchSeeds::kDistinct), 7u + (uint64_t{3} << 40));
+    EXPECT_THROW(ParseBatchSeeds("other"), Error);
 }
 
 TEST(Spectral, FilesAreValidatedNamingTheField) {

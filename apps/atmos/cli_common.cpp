@@ -100,6 +100,12 @@ void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour) {
                     "spectral run: START:STOP:COUNT (nm, both ends included) or a list a,b,c; "
                     "the atmosphere is evaluated at each wavelength and the model run in "
                     "batches of three");
+    cmd->add_option("--batch-seeds", flags->batch_seeds,
+                    "with --wavelengths, Monte Carlo models: same (every batch of three "
+                    "wavelengths uses the seed: correlated wavelengths, little colour noise) or "
+                    "distinct (batch b uses seed + b 2^40: independent batches, less luminance "
+                    "noise, more colour noise)")
+        ->capture_default_str();
     if (!colour) return;
     cmd->add_option("--colour", flags->colour,
                     "with --wavelengths: the colour of the RGB output, srgb (linear) or xyz "

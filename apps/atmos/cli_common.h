@@ -57,6 +57,7 @@ struct SpectralFlags {
     std::string wavelengths;
     std::string colour = "srgb";
     std::string white = "d65";
+    std::string batch_seeds = "same";  // harness/spectral_run.h BatchSeeds
 };
 void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour = true);
 

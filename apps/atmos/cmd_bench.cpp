@@ -139,12 +139,14 @@ int BenchSpectral(const BenchOptions& o, const std::vector<ModelSpec>& models,
                 rr.push_back(Seconds(t0));
                 double prepare_s = 0.0;
                 t0 = std::chrono::steady_clock::now();
-                RenderSpectral(spec, spectral, nm, request,
-                               [&](const AtmosphereParameters& a, Model* m) {
-                                   const auto p0 = std::chrono::steady_clock::now();
-                                   m->Prepare(a);
-                                   prepare_s += Seconds(p0);
-                               });
+                RenderSpectral(
+                    spec, spectral, nm, request,
+                    [&](const AtmosphereParameters& a, Model* m) {
+                        const auto p0 = std::chrono::steady_clock::now();
+                        m->Prepare(a);
+                        prepare_s += Seconds(p0);
+                    },
+                    ParseBatchSeeds(o.spectral.batch_seeds));
                 const double total = Seconds(t0);
                 sp.push_back(prepare_s);
                 sr.push_back(total - prepare_s);

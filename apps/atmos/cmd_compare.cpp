@@ -56,6 +56,7 @@ struct CompareCliOptions {
     std::string exposure = "atmos";
     std::string command_line;
     SpectralFlags spectral;
+    std::string reference_wavelengths;
 };
 
 bool IsRegistered(const std::string& name) {
@@ -85,6 +86,20 @@ int CmdCompare(const CompareCliOptions& o) {
         for (const std::string& m : o.models)
             RequireSpectralModel(GetModelInfo(ParseModelSpec(m).name));
     }
+    if (!o.reference_wavelengths.empty()) {
+        // What RGB costs: the reference spectral (as linear sRGB), the models RGB.
+        if (!o.spectral.wavelengths.empty()) {
+            Fail("--reference-wavelengths compares the RGB models: drop --wavelengths");
+        }
+        if (config.quantity != Quantity::kRadiance) {
+            Fail("--reference-wavelengths compares radiance");
+        }
+        if (o.spectral.colour != "srgb")
+            Fail("compare --reference-wavelengths compares --colour srgb");
+        config.reference_wavelengths = ParseWavelengths(o.reference_wavelengths);
+        config.spectral_atmosphere = LoadSpectralAtmosphere(o.atmosphere, o.sets);
+        config.white = ParseWhitePoint(o.spectral.white);
+    }
     config.output_dir = !o.output.empty()                             ? o.output
                         : config.quantity == Quantity::kTransmittance ? "out/transmittance"
                                                                       : "out";
@@ -100,6 +115,7 @@ int CmdCompare(const CompareCliOptions& o) {
     config.flip.tone_mapper = ParseFlipToneMapper(o.tone_mapper);
     config.flip.exposure_setup = ParseFlipExposureSetup(o.exposure);
     config.command_line = o.command_line;
+    config.batch_seeds = ParseBatchSeeds(o.spectral.batch_seeds);
 
     // The reference: `reference` (the path tracer) when registered, else a stand-in.
     const bool monte_carlo_given =
@@ -140,6 +156,12 @@ int CmdCompare(const CompareCliOptions& o) {
             config.reference_model, " is not one)");
     }
     CreateModel(config.reference_model, config.reference_options);  // validate the options
+    if (!config.reference_wavelengths.empty()) {
+        config.reference_note += "; rendered spectrally at " +
+                                 std::to_string(config.reference_wavelengths.size()) +
+                                 " wavelengths (--reference-wavelengths), the models in RGB; "
+                                 "rgb_cost.csv compares each model with the RGB reference too";
+    }
 
     CheckOutputDirectory(config.output_dir);  // after the flags, before the work (io/output_path.h)
     ThreadLimit limit(o.threads);
@@ -214,6 +236,11 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
     cmd->add_flag("--quiet,-q", o->quiet, "no progress lines");
     AddBackendOption(cmd, &o->backend);
     AddSpectralFlags(cmd, &o->spectral);
+    cmd->add_option(
+        "--reference-wavelengths", o->reference_wavelengths,
+        "what RGB costs: the reference rendered at these wavelengths (as --wavelengths; "
+        "linear sRGB with --white), the models in RGB; each model's FLIP against it "
+        "and against the RGB reference in rgb_cost.csv");
     Command c;
     c.app = cmd;
     c.run = [o] { return CmdCompare(*o); };

@@ -55,29 +55,47 @@ int RenderSpectralViews(const CommonOptions& common, const RenderOptions& ro,
     const std::vector<double> nm = ParseWavelengths(ro.spectral.wavelengths);
     const ColourOutput colour = ParseColourOutput(ro.spectral.colour);
     const WhitePoint white = ParseWhitePoint(ro.spectral.white);
+    const BatchSeeds seeds = ParseBatchSeeds(ro.spectral.batch_seeds);
     const SpectralAtmosphere atmosphere = LoadSpectralAtmosphere(common.atmosphere, common.sets);
     const bool all_views = ro.view == "all";
+    // Every view per batch: one Prepare per batch for all the views (in groups of
+    // at most 1 GiB of spectral images).
+    std::vector<RenderRequest> requests;
     for (const View& view : views) {
-        RenderRequest request = ViewRequest(view, width, height, quantity, monte_carlo);
-        request.sun_disc = ro.sun_disc;
+        requests.push_back(ViewRequest(view, width, height, quantity, monte_carlo));
+        requests.back().sun_disc = ro.sun_disc;
+    }
+    for (const std::vector<size_t>& group : SpectralRequestGroups(requests, nm.size())) {
+        std::vector<RenderRequest> group_requests;
+        for (size_t v : group) group_requests.push_back(requests[v]);
         const auto start = std::chrono::steady_clock::now();
-        const SpectralImage spectral = RenderSpectral(
-            GivenModel(common), atmosphere, nm, request,
-            [&](const AtmosphereParameters& a, Model* model) { PrepareModel(common, a, model); });
+        const std::vector<SpectralImage> spectra = RenderSpectralRequests(
+            GivenModel(common), atmosphere, nm, group_requests,
+            [&](const AtmosphereParameters& a, Model* model) { PrepareModel(common, a, model); },
+            nullptr, nullptr, seeds);
         const double seconds = Seconds(start);
-        const Image image = SpectralToColour(spectral, colour, white);
-        const std::string output =
-            all_views ? (fs::path(ro.output) / (common.model + "-" + view.name + ".exr")).string()
-                      : ro.output;
-        const std::string stem = fs::path(output).replace_extension().string();
-        WriteImage(image, output, ro.exposure > 0.0f ? ro.exposure : view.exposure);
-        WriteSpectralExr(spectral, stem + ".spectral.exr");
         if (!common.quiet) {
             std::fprintf(stderr,
-                         "rendered %-22s %dx%d with %s at %zu wavelengths (%zu batches) in "
-                         "%.3f s; wrote %s and %s.spectral.exr\n",
-                         view.name.c_str(), width, height, common.model.c_str(), nm.size(),
-                         (nm.size() + 2) / 3, seconds, output.c_str(), stem.c_str());
+                         "rendered %zu view(s) %dx%d with %s at %zu wavelengths (%zu batches) in "
+                         "%.3f s\n",
+                         group.size(), width, height, common.model.c_str(), nm.size(),
+                         (nm.size() + 2) / 3, seconds);
+        }
+        for (size_t i = 0; i < group.size(); ++i) {
+            const View& view = views[group[i]];
+            const SpectralImage& spectral = spectra[i];
+            const Image image = SpectralToColour(spectral, colour, white);
+            const std::string output =
+                all_views
+                    ? (fs::path(ro.output) / (common.model + "-" + view.name + ".exr")).string()
+                    : ro.output;
+            const std::string stem = fs::path(output).replace_extension().string();
+            WriteImage(image, output, ro.exposure > 0.0f ? ro.exposure : view.exposure);
+            WriteSpectralExr(spectral, stem + ".spectral.exr");
+            if (!common.quiet) {
+                std::fprintf(stderr, "wrote %s and %s.spectral.exr\n", output.c_str(),
+                             stem.c_str());
+            }
         }
     }
     return 0;

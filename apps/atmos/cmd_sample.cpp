@@ -218,10 +218,10 @@ int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const S
     if (!spectral.wavelengths.empty()) {
         ParseWavelengths(spectral.wavelengths);  // fail before reading stdin
         const MonteCarloSettings mc = flags.Settings(CreateModel(GivenModel(common))->Info());
-        if (!io.output.empty() && io.output != "-") {
-            Fail("--output is not supported with --wavelengths: the spectral columns go to stdout");
-        }
-        return SampleSpectralCsv(common, mc, spectral.wavelengths, ReadQueries(io.input));
+        const bool npy = !io.output.empty() && io.output != "-" && IsNpyPath(io.output);
+        const BatchSeeds seeds = ParseBatchSeeds(spectral.batch_seeds);
+        return SampleSpectralCsv(common, mc, spectral.wavelengths, ReadQueries(io.input), seeds,
+                                 io.output, npy);
     }
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(GivenModel(common));

@@ -23,6 +23,7 @@
 #include "harness/spectral_run.h"
 #include "io/output_path.h"
 #include "render/progressive.h"
+#include "validate_fit.h"
 
 namespace atmos::cli {
 
@@ -42,6 +43,11 @@ struct ValidateOptions {
     bool quiet = false;
     int64_t spp = 256;
     int64_t seed = 0;
+    bool fit = false;
+    std::string fit_model = "hillaire";
+    std::string fit_wavelengths = "442.25,548,677.25";
+    std::string fit_captures;  // empty: those of --captures
+    int fit_evaluations = 40;
 };
 
 std::vector<std::string> SplitList(const std::string& text) {
@@ -159,7 +165,51 @@ int CmdValidate(const ValidateOptions& o) {
     std::vector<SampleQuery> queries;
     for (const KiderSample& s : samples) queries.push_back(KiderQuery(s, o.theory_azimuth));
     const std::vector<double> nm = KiderWavelengths();
-    const SpectralAtmosphere atmosphere = LoadSpectralAtmosphere(o.atmosphere, o.sets);
+    std::vector<std::string> sets = o.sets;
+    if (o.fit) {
+        // The aerosol fitted on --fit-captures at --fit-wavelengths with --fit-model,
+        // then every --model evaluated with it below (validate_fit.h).
+        AerosolFitSettings settings;
+        settings.model = o.fit_model;
+        RequireSpectralModel(GetModelInfo(ParseModelSpec(o.fit_model).name));
+        settings.monte_carlo = MakeMonteCarloSettings(o.spp, o.seed, 0, "--spp");
+        settings.nm = ParseWavelengths(o.fit_wavelengths);
+        settings.max_evaluations = o.fit_evaluations;
+        settings.quiet = o.quiet;
+        const std::vector<std::string> fit_wanted =
+            o.fit_captures.empty() ? wanted : SplitList(o.fit_captures);
+        std::vector<KiderSample> fit_samples;
+        std::vector<SampleQuery> fit_queries;
+        for (const KiderSample& s : all) {
+            if (s.suspect) continue;
+            if (!fit_wanted.empty() &&
+                std::find(fit_wanted.begin(), fit_wanted.end(), s.capture) == fit_wanted.end()) {
+                continue;
+            }
+            fit_samples.push_back(s);
+            fit_queries.push_back(KiderQuery(s, o.theory_azimuth));
+        }
+        if (fit_samples.empty()) Fail("validate: no capture matches --fit-captures");
+        const auto start = std::chrono::steady_clock::now();
+        const AerosolFit fit = FitAerosol(settings, o.atmosphere, o.sets, fit_samples, fit_queries);
+        sets = fit.sets;
+        // The result (always printed: it is what --fit is for).
+        std::fprintf(stderr,
+                     "aerosol fit (%s, %zu directions x %zu wavelengths, %d evaluations, %.0f s, "
+                     "%s): relative RMSE %.2f %% (start %.2f %%)\n",
+                     o.fit_model.c_str(), fit_samples.size(), settings.nm.size(), fit.evaluations,
+                     Seconds(start), fit.stop.c_str(), 100.0 * fit.residual,
+                     100.0 * fit.start_residual);
+        for (int i = 0; i < 4; ++i) {
+            std::fprintf(stderr, "  %-7s %.6g (start %.6g, bounds [%g, %g])\n",
+                         kAerosolParameters[i].name, fit.values[i], fit.start_values[i],
+                         kAerosolParameters[i].lower, kAerosolParameters[i].upper);
+        }
+        std::string flags;
+        for (size_t i = o.sets.size(); i < fit.sets.size(); ++i) flags += " --set " + fit.sets[i];
+        std::fprintf(stderr, "  as flags:%s\n", flags.c_str());
+    }
+    const SpectralAtmosphere atmosphere = LoadSpectralAtmosphere(o.atmosphere, sets);
 
     std::ostringstream csv;
     csv << "model,capture,scope,region,rel_rmse_percent,abs_rmse_1e-3,mean_model_1e-3,"
@@ -280,6 +330,22 @@ Command AddValidateCommand(CLI::App* root) {
     c.app->add_option("--html", o->html,
                       "HTML page with one plot per capture: measured and modelled radiance at "
                       "442, 548 and 677 nm along the samples");
+    c.app->add_flag("--fit", o->fit,
+                    "first fit the aerosol (Angstrom beta and alpha, single-scattering albedo, "
+                    "Cornette-Shanks g; bounded least squares, NLopt BOBYQA) with --fit-model at "
+                    "--fit-wavelengths on --fit-captures, then evaluate --models with it");
+    c.app->add_option("--fit-model", o->fit_model, "--fit: the model evaluated by the fit")
+        ->capture_default_str();
+    c.app
+        ->add_option("--fit-wavelengths", o->fit_wavelengths,
+                     "--fit: Kider bins (nm) the fit compares, a list or START:STOP:COUNT")
+        ->capture_default_str();
+    c.app->add_option("--fit-captures", o->fit_captures,
+                      "--fit: captures the fit compares (default: those of --captures)");
+    c.app
+        ->add_option("--fit-evaluations", o->fit_evaluations,
+                     "--fit: the most model evaluations of the optimiser")
+        ->capture_default_str();
     c.app->add_option("--threads", o->threads, "worker threads (0: all cores)");
     c.app->add_flag("--quiet,-q", o->quiet, "no summary on stderr");
     c.run = [o] { return CmdValidate(*o); };

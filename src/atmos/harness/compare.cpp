@@ -40,6 +40,7 @@ class LazyRenderer {
           config_(config),
           cache_(cache),
           monte_carlo_(monte_carlo) {
+        wavelengths_ = config.wavelengths;
         key_.model = name_;
         key_.options = ResolvedModelOptions(name_, options_);
         key_.monte_carlo = GetModelInfo(name_).capabilities.stochastic;
@@ -59,7 +60,7 @@ class LazyRenderer {
         Image image;
         MonteCarloReport local;
         if (!report) report = &local;
-        if (!config_.wavelengths.empty()) return RenderSpectralColour(view, seconds, cached);
+        if (!wavelengths_.empty()) return RenderSpectralColour(view, seconds, cached, report);
         if (cache_.Load(key, &image, seconds, report, variance)) {
             *cached = true;
             return image;
@@ -91,6 +92,10 @@ class LazyRenderer {
         return image;
     }
 
+    // The views of the run (a spectral run renders them all on the first call).
+    void SetViews(const std::vector<View>& views) { views_ = views; }
+    // Render at these wavelengths (the constructor takes config.wavelengths).
+    void SetWavelengths(const std::vector<double>& nm) { wavelengths_ = nm; }
     double prepare_seconds() const { return prepare_seconds_; }
     bool prepared() const { return prepared_; }
     int64_t table_bytes() const { return table_bytes_; }
@@ -106,32 +111,78 @@ class LazyRenderer {
     }
 
   private:
-    // --wavelengths: the view at every wavelength, as linear sRGB (Prepare per
-    // batch and view, counted in prepare_seconds).
-    Image RenderSpectralColour(const View& view, double* seconds, bool* cached) {
-        RenderRequest request;
-        request.view = view;
-        request.width = config_.width;
-        request.height = config_.height;
-        request.quantity = config_.quantity;
-        request.show_progress = false;
-        request.monte_carlo = monte_carlo_;
-        double prepare = 0.0;
-        const auto start = std::chrono::steady_clock::now();
-        const SpectralImage spectral = RenderSpectral(
-            ModelSpec{name_, name_, options_}, config_.spectral_atmosphere, config_.wavelengths,
-            request, [&](const AtmosphereParameters& a, Model* m) {
-                const auto p0 = std::chrono::steady_clock::now();
-                m->Prepare(a);
-                prepare += SecondsSince(p0);
-            });
-        *seconds = SecondsSince(start) - prepare;
-        prepare_seconds_ += prepare;
-        prepared_ = true;
+    // --wavelengths: the views at every wavelength, as linear sRGB. The first
+    // call renders every view of the run (SetViews; in groups of at most 1 GiB of
+    // spectral images), batch by batch, so that each batch's model is prepared
+    // once for all views of the group (counted in prepare_seconds);
+    // the colour images are kept for the later calls. A Monte Carlo report gives
+    // the paths per pixel over all batches and the largest batch noise.
+    Image RenderSpectralColour(const View& view, double* seconds, bool* cached,
+                               MonteCarloReport* report) {
+        if (spectral_views_.find(view.name) == spectral_views_.end()) {
+            RenderRequest sized;
+            sized.width = config_.width;
+            sized.height = config_.height;
+            const std::vector<RenderRequest> all(views_.size(), sized);
+            // The group of views (at most 1 GiB of spectral images) holding `view`.
+            std::vector<View> group_views;
+            for (const std::vector<size_t>& group :
+                 SpectralRequestGroups(all, wavelengths_.size())) {
+                for (size_t v : group) {
+                    if (views_[v].name == view.name) {
+                        for (size_t w : group) group_views.push_back(views_[w]);
+                    }
+                }
+            }
+            if (group_views.empty()) Fail("compare: view '", view.name, "' not in the run");
+            std::vector<RenderRequest> requests;
+            for (const View& v : group_views) {
+                RenderRequest request;
+                request.view = v;
+                request.width = config_.width;
+                request.height = config_.height;
+                request.quantity = config_.quantity;
+                request.show_progress = false;
+                request.monte_carlo = monte_carlo_;
+                requests.push_back(request);
+            }
+            double prepare = 0.0;
+            std::vector<double> render_seconds;
+            std::vector<MonteCarloReport> reports;
+            const std::vector<SpectralImage> spectral = RenderSpectralRequests(
+                ModelSpec{name_, name_, options_}, config_.spectral_atmosphere, wavelengths_,
+                requests,
+                [&](const AtmosphereParameters& a, Model* m) {
+                    const auto p0 = std::chrono::steady_clock::now();
+                    m->Prepare(a);
+                    prepare += SecondsSince(p0);
+                },
+                &render_seconds, &reports, config_.batch_seeds);
+            prepare_seconds_ += prepare;
+            prepared_ = true;
+            for (size_t v = 0; v < group_views.size(); ++v) {
+                SpectralView& out = spectral_views_[group_views[v].name];
+                out.image = SpectralToColour(spectral[v], ColourOutput::kSrgb, config_.white);
+                out.seconds = render_seconds[v];
+                out.report = reports[v];
+            }
+        }
+        const auto it = spectral_views_.find(view.name);
+        if (it == spectral_views_.end()) Fail("compare: view '", view.name, "' not in the run");
+        *seconds = it->second.seconds;
         *cached = false;
-        return SpectralToColour(spectral, ColourOutput::kSrgb, config_.white);
+        *report = it->second.report;
+        return it->second.image;
     }
 
+    struct SpectralView {
+        Image image;
+        double seconds = 0.0;
+        MonteCarloReport report;
+    };
+    std::vector<View> views_;
+    std::vector<double> wavelengths_;
+    std::map<std::string, SpectralView> spectral_views_;
     std::string name_;
     std::map<std::string, std::string> options_;
     const CompareConfig& config_;
@@ -246,6 +297,7 @@ CompareResult RunCompare(const CompareConfig& config) {
     if (config.models.empty()) {
         for (const ModelInfo& info : ListModels()) {
             if (info.name == "reference") continue;
+            if (!config.wavelengths.empty() && !HasSpectralForm(info)) continue;
             if (transmittance ? !info.capabilities.transmittance : !info.capabilities.radiance) {
                 continue;
             }
@@ -309,7 +361,23 @@ CompareResult RunCompare(const CompareConfig& config) {
     std::vector<std::unique_ptr<LazyRenderer>> renderers;
     for (const ModelSpec& spec : specs) {
         renderers.push_back(std::make_unique<LazyRenderer>(spec.name, spec.options, config, cache));
+        renderers.back()->SetViews(views);
     }
+    reference.SetViews(views);
+    reference_b.SetViews(views);
+    // What RGB costs: the reference spectral, and the RGB reference beside it.
+    const bool spectral_reference = !config.reference_wavelengths.empty();
+    if (spectral_reference) {
+        if (!config.wavelengths.empty()) {
+            Fail("compare: --reference-wavelengths compares RGB models (no --wavelengths)");
+        }
+        if (transmittance) Fail("compare: --reference-wavelengths compares radiance");
+        reference.SetWavelengths(config.reference_wavelengths);
+        reference_b.SetWavelengths(config.reference_wavelengths);
+    }
+    LazyRenderer rgb_reference(config.reference_model, config.reference_options, config, cache,
+                               whole);
+    rgb_reference.SetViews(views);
 
     for (const View& view : views) {
         CompareRow row;
@@ -375,6 +443,12 @@ CompareResult RunCompare(const CompareConfig& config) {
                 row.profiles.push_back(std::move(profile));
             }
         }
+        Image rgb_ref;
+        if (spectral_reference) {
+            bool cached_rgb = false;
+            rgb_ref = rgb_reference.Render(view, &row.rgb_reference_seconds, &cached_rgb);
+            WriteImages(rgb_ref, image_dir, "reference-rgb", exposure, config.write_npy);
+        }
         WriteImages(ref, image_dir, "reference", exposure, config.write_npy);
         row.reference_png = (fs::path("images") / FileStem(view.name) / "reference.png").string();
         if (config.show_progress) {
@@ -401,6 +475,8 @@ CompareResult RunCompare(const CompareConfig& config) {
             const RmseResult rmse = ComputeRmse(ref, img);
             cell.flip = flip.mean;
             cell.rmse = rmse.overall;
+            if (spectral_reference)
+                cell.flip_rgb_reference = HdrFlip(rgb_ref, img, config.flip).mean;
             for (CompareRow::Profile& profile : row.profiles) {
                 profile.models.push_back(ProfileLuminance(img, profile.line));
             }
@@ -418,10 +494,14 @@ CompareResult RunCompare(const CompareConfig& config) {
             cell.rmse_png =
                 (fs::path("errors") / FileStem(view.name) / (stem + "-rmse.png")).string();
             if (config.show_progress) {
-                std::fprintf(stderr, "%-22s %-20s %s %.3f s  FLIP %.6f  RMSE %.8f%s\n",
+                std::fprintf(stderr, "%-22s %-20s %s %.3f s  FLIP %.6f  RMSE %.8f%s",
                              view.name.c_str(), name.c_str(), cell.cached ? "cached" : "rendered",
                              cell.render_seconds, cell.flip, cell.rmse,
                              cell.validity_note.empty() ? "" : "  (outside validity)");
+                if (spectral_reference) {
+                    std::fprintf(stderr, "  FLIP vs RGB reference %.6f", cell.flip_rgb_reference);
+                }
+                std::fprintf(stderr, "\n");
             }
             row.cells.push_back(cell);
         }
@@ -473,6 +553,19 @@ CompareResult RunCompare(const CompareConfig& config) {
               << (noise_target ? mc.noise_target : 0.0) << "\n";
         }
         f.Commit();
+    }
+    if (spectral_reference) {
+        // What RGB costs: each model against the spectral and the RGB reference.
+        std::ofstream f(out / "rgb_cost.csv");
+        f << "view,model,flip_spectral_reference,flip_rgb_reference,difference\n";
+        for (const CompareRow& row : result.rows) {
+            for (size_t m = 0; m < result.models.size(); ++m) {
+                const CompareCell& c = row.cells[m];
+                f << row.view << "," << result.models[m] << "," << c.flip << ","
+                  << c.flip_rgb_reference << "," << c.flip - c.flip_rgb_reference << "\n";
+            }
+        }
+        if (!f) Fail("cannot write '", (out / "rgb_cost.csv").string(), "'");
     }
     {
         TextOutput f((out / "times.csv").string());

@@ -20,6 +20,7 @@
 #include "atmos/view.h"
 #include "harness/loc.h"
 #include "harness/profiles.h"
+#include "harness/spectral_run.h"
 #include "metrics/flip.h"
 
 namespace atmos {
@@ -43,11 +44,18 @@ struct CompareConfig {
     AtmosphereParameters atmosphere;
     // Spectral comparison (--wavelengths; harness/spectral_run.h): every model and
     // the reference rendered at these wavelengths of `spectral_atmosphere` (each
-    // view re-prepares the batches; no render cache) and compared as linear sRGB
-    // with `white`. Empty: the RGB comparison.
+    // batch prepared once per model for all views, RenderSpectralRequests; no
+    // render cache) and compared as linear sRGB with `white`. Empty: the RGB
+    // comparison.
     std::vector<double> wavelengths;
+    // What RGB costs (--reference-wavelengths): the reference alone rendered at
+    // these wavelengths of `spectral_atmosphere` (as linear sRGB with `white`),
+    // the models in RGB; each model is also compared with the RGB reference
+    // (CompareCell::flip_rgb_reference, rgb_cost.csv). Empty: off.
+    std::vector<double> reference_wavelengths;
     SpectralAtmosphere spectral_atmosphere;
     WhitePoint white = WhitePoint::kD65;
+    BatchSeeds batch_seeds = BatchSeeds::kSame;  // a Monte Carlo model's batches
     std::string output_dir = "out";
     std::string cache_dir;  // empty: no cache
     FlipOptions flip;
@@ -60,6 +68,8 @@ struct CompareCell {
     double flip = 0.0;
     double rmse = 0.0;
     double render_seconds = 0.0;
+    // --reference-wavelengths: HDR-FLIP against the RGB reference (else < 0).
+    double flip_rgb_reference = -1.0;
     bool cached = false;
     std::string validity_note;  // non-empty: the view is outside the model's declared validity
     // FLIP at or below the row's reference_noise: the difference to the
@@ -77,6 +87,8 @@ struct CompareRow {
     std::string reference_png;
     double reference_seconds = 0.0;
     bool reference_cached = false;
+    // --reference-wavelengths: the RGB reference's render time (else 0).
+    double rgb_reference_seconds = 0.0;
     // A Monte Carlo reference is rendered as two independent halves (spp/2
     // each, seeds 2s+1 and 2s+2) and averaged; this is the HDR-FLIP between the
     // halves: the reference's own noise, an upper bound for its error at the full

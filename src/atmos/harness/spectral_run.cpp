@@ -2,6 +2,7 @@
 #include "harness/spectral_run.h"
 
 #include <algorithm>
+#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,6 +32,17 @@ std::unique_ptr<Model> PrepareBatch(const ModelSpec& spec, const SpectralAtmosph
 
 }  // namespace
 
+BatchSeeds ParseBatchSeeds(const std::string& text) {
+    if (text == "same") return BatchSeeds::kSame;
+    if (text == "distinct") return BatchSeeds::kDistinct;
+    Fail("--batch-seeds '", text, "': expected same or distinct");
+}
+
+uint64_t BatchSeed(uint64_t seed, size_t batch, BatchSeeds seeds) {
+    // CLI seeds are below 2^32 (halves: 2s + 2 < 2^34): b * 2^40 keeps them apart.
+    return seeds == BatchSeeds::kSame ? seed : seed + (static_cast<uint64_t>(batch) << 40);
+}
+
 bool HasSpectralForm(const ModelInfo& info) {
     return info.name != "preetham" && info.name != "neural";
 }
@@ -45,40 +57,83 @@ void RequireSpectralModel(const ModelInfo& info) {
 
 SpectralImage RenderSpectral(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
                              const std::vector<double>& nm, const RenderRequest& request,
-                             const PrepareFunction& prepare) {
-    SpectralImage out;
-    out.width = request.width;
-    out.height = request.height;
-    out.nm = nm;
+                             const PrepareFunction& prepare, BatchSeeds seeds) {
+    return RenderSpectralRequests(spec, atmosphere, nm, {request}, prepare, nullptr, nullptr, seeds)
+        .front();
+}
+
+std::vector<SpectralImage> RenderSpectralRequests(
+    const ModelSpec& spec, const SpectralAtmosphere& atmosphere, const std::vector<double>& nm,
+    const std::vector<RenderRequest>& requests, const PrepareFunction& prepare,
+    std::vector<double>* render_seconds, std::vector<MonteCarloReport>* reports, BatchSeeds seeds) {
     const size_t n = nm.size();
-    const size_t pixels = static_cast<size_t>(request.width) * request.height;
-    out.values.assign(pixels * n, 0.0f);
+    std::vector<SpectralImage> out(requests.size());
+    for (size_t v = 0; v < requests.size(); ++v) {
+        out[v].width = requests[v].width;
+        out[v].height = requests[v].height;
+        out[v].nm = nm;
+        out[v].values.assign(static_cast<size_t>(requests[v].width) * requests[v].height * n, 0.0f);
+    }
+    if (render_seconds) render_seconds->assign(requests.size(), 0.0);
+    if (reports) reports->assign(requests.size(), MonteCarloReport());
     for (size_t b = 0; 3 * b < n; ++b) {
         double l[3];
         BatchWavelengths(nm, b, l);
         AtmosphereParameters batch;
         std::unique_ptr<Model> model = PrepareBatch(spec, atmosphere, l, prepare, &batch);
-        RenderRequest r = request;
-        r.checkpoint.clear();
-        r.resume = false;
-        r.variance = nullptr;
-        r.report = nullptr;
-        Image image;
-        model->Render(r, &image);
-        for (size_t p = 0; p < pixels; ++p) {
-            for (size_t c = 0; c < 3 && 3 * b + c < n; ++c) {
-                out.values[p * n + 3 * b + c] = image.data()[p * 3 + c];
+        for (size_t v = 0; v < requests.size(); ++v) {
+            RenderRequest r = requests[v];
+            r.checkpoint.clear();
+            r.resume = false;
+            r.variance = nullptr;
+            r.monte_carlo.seed = BatchSeed(r.monte_carlo.seed, b, seeds);
+            MonteCarloReport report;
+            r.report = &report;
+            Image image;
+            const auto start = std::chrono::steady_clock::now();
+            model->Render(r, &image);
+            if (render_seconds) {
+                (*render_seconds)[v] +=
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            }
+            if (reports) {
+                MonteCarloReport& total = (*reports)[v];
+                total.samples += report.samples;
+                total.noise = std::max(total.noise, report.noise);
+            }
+            const size_t pixels = static_cast<size_t>(r.width) * r.height;
+            for (size_t p = 0; p < pixels; ++p) {
+                for (size_t c = 0; c < 3 && 3 * b + c < n; ++c) {
+                    out[v].values[p * n + 3 * b + c] = image.data()[p * 3 + c];
+                }
             }
         }
     }
     return out;
 }
 
+std::vector<std::vector<size_t>> SpectralRequestGroups(const std::vector<RenderRequest>& requests,
+                                                       size_t wavelengths, size_t max_bytes) {
+    std::vector<std::vector<size_t>> groups;
+    size_t bytes = 0;
+    for (size_t i = 0; i < requests.size(); ++i) {
+        const size_t b = static_cast<size_t>(requests[i].width) *
+                         static_cast<size_t>(requests[i].height) * wavelengths * sizeof(float);
+        if (groups.empty() || bytes + b > max_bytes) {
+            groups.emplace_back();
+            bytes = 0;
+        }
+        groups.back().push_back(i);
+        bytes += b;
+    }
+    return groups;
+}
+
 std::vector<double> SampleSpectral(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
                                    const std::vector<double>& nm,
                                    const std::vector<SampleQuery>& queries,
                                    const MonteCarloSettings& monte_carlo,
-                                   const PrepareFunction& prepare) {
+                                   const PrepareFunction& prepare, BatchSeeds seeds) {
     const size_t n = nm.size();
     std::vector<double> out(queries.size() * n, 0.0);
     for (size_t b = 0; 3 * b < n; ++b) {
@@ -86,9 +141,11 @@ std::vector<double> SampleSpectral(const ModelSpec& spec, const SpectralAtmosphe
         BatchWavelengths(nm, b, l);
         AtmosphereParameters batch;
         std::unique_ptr<Model> model = PrepareBatch(spec, atmosphere, l, prepare, &batch);
-        const std::vector<SampleAnswer> answers =
-            model->Info().capabilities.stochastic ? SampleMonteCarlo(*model, queries, monte_carlo)
-                                                  : model->Sample(queries);
+        MonteCarloSettings mc = monte_carlo;
+        mc.seed = BatchSeed(mc.seed, b, seeds);
+        const std::vector<SampleAnswer> answers = model->Info().capabilities.stochastic
+                                                      ? SampleMonteCarlo(*model, queries, mc)
+                                                      : model->Sample(queries);
         for (size_t q = 0; q < queries.size(); ++q) {
             for (size_t c = 0; c < 3 && 3 * b + c < n; ++c) {
                 const int ci = static_cast<int>(c);

@@ -8,6 +8,7 @@
 // the same random numbers at every wavelength; no checkpoints or variance).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -26,6 +27,16 @@ struct SpectralImage {
     std::vector<float> values;
 };
 
+// The random numbers of a Monte Carlo model's batches. kSame: every batch uses
+// the run's seed (a pixel's paths are the same random numbers at every
+// wavelength: the noise of the N values is correlated, colour noise small,
+// luminance as noisy as one batch). kDistinct: batch b uses seed + b * 2^40
+// (independent batches: luminance averages the noise of the batches it spans,
+// about 4.3 of the 14 batches of 360-818.25 nm for CIE y; colour noise larger).
+enum class BatchSeeds { kSame, kDistinct };
+BatchSeeds ParseBatchSeeds(const std::string& text);  // "same" or "distinct"
+uint64_t BatchSeed(uint64_t seed, size_t batch, BatchSeeds seeds);
+
 // Prepare()s a model for one batch's atmosphere (the CLI passes its PrepareModel).
 using PrepareFunction = std::function<void(const AtmosphereParameters&, Model*)>;
 
@@ -38,7 +49,27 @@ void RequireSpectralModel(const ModelInfo& info);
 // pixel's irradiance), in the solar spectrum's units per steradian.
 SpectralImage RenderSpectral(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
                              const std::vector<double>& nm, const RenderRequest& request,
-                             const PrepareFunction& prepare);
+                             const PrepareFunction& prepare, BatchSeeds seeds = BatchSeeds::kSame);
+
+// Renders every request (e.g. the views of a compare, any sizes) at each
+// wavelength: one Prepare per batch for all the requests (the batches outer, the
+// requests inner, one prepared model alive at a time). render_seconds (optional):
+// per request, its render time summed over the batches (Prepare excluded).
+// reports (optional, Monte Carlo models): per request, the paths per pixel summed
+// over the batches and the largest noise of a batch's three-channel image (each
+// batch renders to the request's noise target on its own).
+std::vector<SpectralImage> RenderSpectralRequests(
+    const ModelSpec& spec, const SpectralAtmosphere& atmosphere, const std::vector<double>& nm,
+    const std::vector<RenderRequest>& requests, const PrepareFunction& prepare,
+    std::vector<double>* render_seconds = nullptr, std::vector<MonteCarloReport>* reports = nullptr,
+    BatchSeeds seeds = BatchSeeds::kSame);
+
+// Groups of consecutive request indices whose spectral images (width x height x
+// wavelengths floats) take at most `max_bytes` together (a request alone may
+// exceed it): the callers of RenderSpectralRequests bound their memory so.
+std::vector<std::vector<size_t>> SpectralRequestGroups(const std::vector<RenderRequest>& requests,
+                                                       size_t wavelengths,
+                                                       size_t max_bytes = size_t{1} << 30);
 
 // Spectral radiance of each query at each wavelength, [q * nm.size() + i]: the
 // sample's radiance per unit irradiance x the solar spectrum (no sun disc, no
@@ -47,7 +78,8 @@ std::vector<double> SampleSpectral(const ModelSpec& spec, const SpectralAtmosphe
                                    const std::vector<double>& nm,
                                    const std::vector<SampleQuery>& queries,
                                    const MonteCarloSettings& monte_carlo,
-                                   const PrepareFunction& prepare);
+                                   const PrepareFunction& prepare,
+                                   BatchSeeds seeds = BatchSeeds::kSame);
 
 enum class ColourOutput { kSrgb, kXyz };
 ColourOutput ParseColourOutput(const std::string& text);  // "srgb" or "xyz"

@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "atmos/error.h"
@@ -70,8 +72,11 @@ MajorantShells BuildMajorantShells(const AtmosphereParameters& atm, int count) {
     return shells;
 }
 
-Vec3d SunOpticalDepthQuadrature(const AtmosphereParameters& atm, double r, double mu,
-                                int intervals) {
+namespace {
+
+// The Rayleigh, Mie and absorption columns (m) from (r, mu) to the top boundary
+// by composite Simpson with `intervals` (even) intervals.
+Vec3d SunColumnQuadrature(const AtmosphereParameters& atm, double r, double mu, int intervals) {
     intervals += intervals & 1;
     const double d = DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius);
     const double h = d / intervals;
@@ -80,13 +85,22 @@ Vec3d SunOpticalDepthQuadrature(const AtmosphereParameters& atm, double r, doubl
         const double t = i * h;
         const double ri = std::sqrt(std::max(r * r + 2.0 * r * mu * t + t * t, 0.0));
         const double w = (i == 0 || i == intervals) ? 1.0 : ((i & 1) ? 4.0 : 2.0);
-        sum += Extinction(atm, GetDensities(atm, ri - atm.bottom_radius)) * w;
+        const Densities density = GetDensities(atm, ri - atm.bottom_radius);
+        sum += Vec3d(density.rayleigh, density.mie, density.absorption) * w;
     }
     return sum * (h / 3.0);
 }
 
-Table BuildSunOpticalDepthTable(const AtmosphereParameters& atm, int mu_size, int r_size,
+}  // namespace
+
+Vec3d SunOpticalDepthQuadrature(const AtmosphereParameters& atm, double r, double mu,
                                 int intervals) {
+    const Vec3d c = SunColumnQuadrature(atm, r, mu, intervals);
+    return atm.rayleigh_scattering * c.x + atm.mie_extinction * c.y +
+           atm.absorption_extinction * c.z;
+}
+
+Table BuildSunColumnTable(const AtmosphereParameters& atm, int mu_size, int r_size, int intervals) {
     Table table(mu_size, r_size, 1, 3);
     const double bottom = atm.bottom_radius, top = atm.top_radius;
     const double H = std::sqrt(top * top - bottom * bottom);
@@ -100,9 +114,9 @@ Table BuildSunOpticalDepthTable(const AtmosphereParameters& atm, int mu_size, in
             const double d = d_min + x_mu * (d_max - d_min);
             const double mu =
                 d == 0.0 ? 1.0 : std::clamp((H * H - rho * rho - d * d) / (2.0 * r * d), -1.0, 1.0);
-            const Vec3d tau = SunOpticalDepthQuadrature(atm, r, mu, intervals);
+            const Vec3d column = SunColumnQuadrature(atm, r, mu, intervals);
             float* texel = table.Texel(i, static_cast<int>(j));
-            for (int c = 0; c < 3; ++c) texel[c] = static_cast<float>(tau[c]);
+            for (int c = 0; c < 3; ++c) texel[c] = static_cast<float>(column[c]);
         }
     });
     return table;
@@ -136,6 +150,30 @@ BrunetonLut BuildReferenceGuideLut(const AtmosphereParameters& atm, Table* trans
     }
     lut.scattering_table = scattering->view();
     return lut;
+}
+
+Table SharedSunColumnTable(const AtmosphereParameters& atm) {
+    // The geometry: radii and the three density profiles (5 numbers per layer).
+    std::vector<double> key = {atm.bottom_radius, atm.top_radius};
+    for (const DensityProfile* p :
+         {&atm.rayleigh_density, &atm.mie_density, &atm.absorption_density}) {
+        for (const DensityProfileLayer& l : p->layers) {
+            key.insert(key.end(),
+                       {l.width, l.exp_term, l.exp_scale, l.linear_term, l.constant_term});
+        }
+    }
+    // The last few geometries (1.5 MB each; the batches of a run share one).
+    constexpr size_t kKeep = 8;
+    static std::mutex mutex;
+    static std::vector<std::pair<std::vector<double>, std::unique_ptr<Table>>> tables;
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& [k, table] : tables) {
+        if (k == key) return *table;
+    }
+    if (tables.size() >= kKeep) tables.erase(tables.begin());
+    tables.emplace_back(key, std::make_unique<Table>(BuildSunColumnTable(
+                                 atm, kSunTableMuSize, kSunTableRSize, kSunTableIntervals)));
+    return *tables.back().second;
 }
 
 ModelInfo ReferenceModel::StaticInfo() {
@@ -234,9 +272,7 @@ void ReferenceModel::Prepare(const AtmosphereParameters& atmosphere) {
     resident_.Reset();
     sun_table_ready_ = false;
     sun_table_ = Table(2, 2, 1, 3);  // until built: a valid table for a device copy
-    evaluator_.sun_table.tau = sun_table_.view();
-    evaluator_.sun_table.bottom = atmosphere.bottom_radius;
-    evaluator_.sun_table.top = atmosphere.top_radius;
+    evaluator_.sun_table.Set(sun_table_.view(), atmosphere);
     // The model's evaluator never names an order-1 table (only a pass's copy
     // does, holding the table alive: Order1Table), so no copy of it can name
     // a freed one.
@@ -254,9 +290,8 @@ void ReferenceModel::Prepare(const AtmosphereParameters& atmosphere) {
 const ReferenceEvaluator& ReferenceModel::evaluator() const {
     std::lock_guard<std::mutex> lock(sun_table_mutex_);
     if (!sun_table_ready_ && evaluator_.estimator == ReferenceEstimator::kHybrid) {
-        sun_table_ = BuildSunOpticalDepthTable(evaluator_.atm, kSunTableMuSize, kSunTableRSize,
-                                               kSunTableIntervals);
-        evaluator_.sun_table.tau = sun_table_.view();
+        sun_table_ = SharedSunColumnTable(evaluator_.atm);
+        evaluator_.sun_table.Set(sun_table_.view(), evaluator_.atm);
         if (evaluator_.guide_candidates > 0) {
             evaluator_.guide_lut =
                 BuildReferenceGuideLut(evaluator_.atm, &guide_transmittance_, &guide_scattering_);

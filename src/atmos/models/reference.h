@@ -110,14 +110,29 @@ enum class ReferenceEstimator : int {
 };
 
 // The sun's transmittance from a point (r, mu_s) to space: 0 when the ray meets
-// the ground (exact geometry), else exp(-tau) with tau bilinear in a table of
-// the optical depth on seed 004's transmittance parameterisation (x_r =
-// rho / H, x_mu = (d - d_min) / (d_max - d_min)), filled by Simpson quadrature
-// (BuildSunOpticalDepthTable). Its error against exact quadrature is measured
-// and bounded by a test (ReferenceHybrid.SunTableMatchesQuadrature).
+// the ground (exact geometry), else exp(-tau) with tau = beta_R c_R + beta_M,ext
+// c_M + beta_A c_A, the column densities c (m, density x length) bilinear in a
+// table on seed 004's transmittance parameterisation (x_r = rho / H, x_mu =
+// (d - d_min) / (d_max - d_min)), filled by Simpson quadrature
+// (BuildSunColumnTable). The columns do not depend on wavelength: every batch of
+// a spectral run shares one table (SharedSunColumnTable); bilinear interpolation
+// is linear, so tau is what a table of optical depths would give. Its error
+// against exact quadrature is measured and bounded by a test
+// (ReferenceHybrid.SunTableMatchesQuadrature).
 struct SunTransmittanceTable {
-    TableView tau;  // 3 channels: optical depth to the top boundary
+    TableView columns;  // 3 channels: Rayleigh, Mie, absorption column to the top boundary
     double bottom = 0.0, top = 0.0;
+    Vec3d rayleigh, mie_extinction, absorption;  // the coefficients (1/m) per channel
+
+    // The table `columns` (BuildSunColumnTable) of the atmosphere `atm`.
+    void Set(const TableView& table, const AtmosphereParameters& atm) {
+        columns = table;
+        bottom = atm.bottom_radius;
+        top = atm.top_radius;
+        rayleigh = atm.rayleigh_scattering;
+        mie_extinction = atm.mie_extinction;
+        absorption = atm.absorption_extinction;
+    }
 
     ATMOS_HD Vec3d Lookup(double r, double mu) const {
         if (RayIntersectsGround(r, mu, bottom)) return Vec3d(0.0);
@@ -129,17 +144,26 @@ struct SunTransmittanceTable {
         const double d_max = rho + H;
         const double x_mu = d_max > d_min ? (d - d_min) / (d_max - d_min) : 0.0;
         const double x_r = rho / H;
-        const Vec4f v = tau.SampleBilinear(GetTextureCoordFromUnitRange(x_mu, tau.width),
-                                           GetTextureCoordFromUnitRange(x_r, tau.height));
-        return Exp(-Vec3d(v.x, v.y, v.z));
+        const Vec4f v = columns.SampleBilinear(GetTextureCoordFromUnitRange(x_mu, columns.width),
+                                               GetTextureCoordFromUnitRange(x_r, columns.height));
+        return Exp(-(rayleigh * static_cast<double>(v.x) +
+                     mie_extinction * static_cast<double>(v.y) +
+                     absorption * static_cast<double>(v.z)));
     }
 };
 
-// Fills a table of mu_size x r_size texels (Simpson, `intervals` per ray).
-Table BuildSunOpticalDepthTable(const AtmosphereParameters& atm, int mu_size, int r_size,
-                                int intervals = 512);
+// Fills a table of mu_size x r_size texels of the Rayleigh, Mie and absorption
+// columns (Simpson, `intervals` per ray). Depends on the radii and the density
+// profiles only.
+Table BuildSunColumnTable(const AtmosphereParameters& atm, int mu_size, int r_size,
+                          int intervals = 512);
+// BuildSunColumnTable(atm, kSunTableMuSize, kSunTableRSize, kSunTableIntervals),
+// built once per geometry (radii and density profiles) in the process and copied
+// out: the batches of a spectral run differ in their coefficients only.
+// Thread-safe; the last few geometries are kept.
+Table SharedSunColumnTable(const AtmosphereParameters& atm);
 // Optical depth from (r, mu) to the top boundary by composite Simpson with
-// `intervals` (even) intervals (what the table holds at its texels).
+// `intervals` (even) intervals (what the table gives at its texels).
 Vec3d SunOpticalDepthQuadrature(const AtmosphereParameters& atm, double r, double mu,
                                 int intervals);
 
@@ -214,7 +238,7 @@ struct ReferenceEvaluator {
 
     template <typename V>
     void VisitTables(V& v) {
-        v(sun_table.tau);
+        v(sun_table.columns);
         v(order1_table);
         v(guide_lut.transmittance_table);
         v(guide_lut.scattering_table);

@@ -1,0 +1,62 @@
+// atmos CLI: `atmos validate kider-2013 --fit`: the aerosol of an atmosphere
+// (Angstrom beta and alpha, single-scattering albedo, Cornette-Shanks g) fitted
+// to the measured sky by bounded least squares (docs/harness.md "Aerosol fit").
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "atmos/model.h"
+#include "harness/kider.h"
+
+namespace atmos::cli {
+
+// The four parameters, their bounds and the --set field each one writes.
+struct AerosolParameter {
+    const char* field;  // e.g. "mie_extinction.angstrom.beta"
+    const char* name;   // e.g. "beta"
+    double lower, upper, step;
+};
+constexpr AerosolParameter kAerosolParameters[4] = {
+    {"mie_extinction.angstrom.beta", "beta", 0.005, 0.3, 0.01},
+    {"mie_extinction.angstrom.alpha", "alpha", 0.0, 2.5, 0.2},
+    {"mie_scattering.single_scattering_albedo", "albedo", 0.5, 1.0, 0.05},
+    {"mie_phase_g", "g", 0.0, 0.95, 0.05},
+};
+
+struct AerosolFitSettings {
+    std::string model = "hillaire";  // a model spec; Monte Carlo models use `monte_carlo`
+    MonteCarloSettings monte_carlo;
+    std::vector<double> nm;  // Kider bins (nm) the fit compares
+    int max_evaluations = 40;
+    bool quiet = false;
+};
+
+struct AerosolFit {
+    double values[4] = {};  // kAerosolParameters order
+    double start_values[4] = {};
+    double residual = 0.0;        // relative RMSE (RMSE / mean measured) on the fit's set
+    double start_residual = 0.0;  // the same with the atmosphere as given
+    int evaluations = 0;
+    std::string stop;  // why the optimiser stopped
+    // `sets` plus the four fitted --set overrides (FIELD=VALUE, %.6g).
+    std::vector<std::string> sets;
+};
+
+// The relative RMSE of `model` with the atmosphere `atmosphere` + `sets` against
+// the measured `samples` at the Kider bins `nm`.
+double KiderResidual(const AerosolFitSettings& settings, const std::string& atmosphere,
+                     const std::vector<std::string>& sets, const std::vector<KiderSample>& samples,
+                     const std::vector<SampleQuery>& queries);
+
+// Bounded least squares (NLopt's BOBYQA, derivative-free) of the four parameters
+// from the atmosphere's own values. Throws atmos::Error when the atmosphere has no
+// Angstrom aerosol or the build has no NLopt.
+AerosolFit FitAerosol(const AerosolFitSettings& settings, const std::string& atmosphere,
+                      const std::vector<std::string>& sets, const std::vector<KiderSample>& samples,
+                      const std::vector<SampleQuery>& queries);
+
+// The Kider bin index of a wavelength (-1 when it is not one of the 40 bins).
+int KiderBinIndex(double nm);
+
+}  // namespace atmos::cli
