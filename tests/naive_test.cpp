@@ -100,7 +100,7 @@ TEST(Naive, VectorLoopMatchesTheScalarIntegral) {
                 for (const auto& pair :
                      {std::make_pair(a.sky[c], b.sky[c]), std::make_pair(a.ground[c], b.ground[c]),
                       std::make_pair(a.transmittance[c], b.transmittance[c])}) {
-                    EXPECT_NEAR(pair.first, pair.second, 4e-7 * std::fabs(pair.second)) << q;
+                    EXPECT_NEAR(pair.first, pair.second, 4e-7f * std::fabs(pair.second)) << q;
                     same += pair.first == pair.second;
                     ++total;
                 }
