@@ -141,20 +141,12 @@ struct NaiveEvaluator {
         RayResult out;
         AtmosphereSegment seg;
         if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) {
-            // A camera on the ground looking down (physics/ray.h): the ground at the camera.
-            if (want_ground && GroundAtCamera(seg) && MaxComponent(atm.ground_albedo) > 0.0) {
-                const double cos_sun = Dot(Normalize(camera), sun);
-                Vec3d tau_sun;
-                if (cos_sun > 0.0 && LightDepth(camera, sun, &tau_sun)) {
-                    out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * ExpLane(-tau_sun));
-                }
-            }
+            SingleScatteringGroundAtCamera(atm, *this, camera, sun, seg, want_ground, &out);
             return out;
         }
         constexpr int kL = kLightLanes;
         const double inf = HUGE_VAL;
         const double ds = (seg.t_end - seg.t_start) / steps;
-        const double nu = Dot(dir, sun);
         const Profiles prof(atm);
         Vec3d tau_view;  // camera to the start of the current step
         Vec3d sum_r, sum_m;
@@ -193,20 +185,8 @@ struct NaiveEvaluator {
                 sum_m += t * (rho_m[k] * ds);
             }
         }
-        const Vec3d sky = atm.rayleigh_scattering * sum_r * RayleighPhase(nu) +
-                          atm.mie_scattering * sum_m * CornetteShanksPhase(atm.mie_phase_g, nu);
-        const Vec3d t_view = ExpLane(-tau_view);
-        out.sky = Rgb(sky);
-        out.transmittance = Rgb(t_view);
-        // The ground (albedo a) lit by the direct sun only: a / pi max(0, n.s) T_sun T_view.
-        if (want_ground && seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0) {
-            const Vec3d g = camera + dir * seg.t_end;
-            const double cos_sun = Dot(Normalize(g), sun);
-            Vec3d tau_sun;
-            if (cos_sun > 0.0 && LightDepth(g, sun, &tau_sun)) {
-                out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * ExpLane(-tau_sun) * t_view);
-            }
-        }
+        FinishSingleScattering(atm, *this, camera, dir, sun, seg, want_ground, sum_r, sum_m,
+                               tau_view, &out);
         return out;
     }
 };
