@@ -49,6 +49,18 @@ if [ "$sanitize" = ON ]; then
     build_type=RelWithDebInfo; cuda=OFF
     extra=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DATMOS_BUILD_BENCH=OFF)
 fi
-cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" \
+# Instruction set (CMakeLists.txt, ATMOS_ARCH): x86-64-v3 (AVX2, FMA) when this
+# machine runs it (glibc's loader lists the levels the CPU supports), else the
+# compiler's baseline. The binaries then need such a CPU: ATMOS_ARCH= (empty)
+# in the environment builds for any x86-64.
+arch="${ATMOS_ARCH-auto}"
+if [ "$arch" = auto ]; then
+    arch=""
+    if [ "$sanitize" = OFF ] && /lib64/ld-linux-x86-64.so.2 --help 2>/dev/null |
+            grep -q "x86-64-v3 (supported"; then
+        arch=x86-64-v3
+    fi
+fi
+cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" -DATMOS_ARCH="$arch" \
       -DATMOS_WERROR="$werror" -DATMOS_SANITIZE="$sanitize" -DATMOS_CUDA="$cuda" "${extra[@]}" >/dev/null
 cmake --build "$build_dir" -j "$(nproc)"

@@ -5,9 +5,11 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -276,6 +278,46 @@ TEST(AtmospherePlus, TransmittanceTableMatchesDirectIntegration) {
         }
         std::printf("transmittance table (64x256) worst abs error: %.2e\n", worst);
         EXPECT_LT(worst, 3e-3) << static_cast<int>(kind);
+    }
+}
+
+TEST(AtmospherePlus, FixedLookupIsTheGenericBitForBit) {
+    // Issue 19: the evaluator's AplusSampleTableFixed<4> (scattering) and <3>
+    // (transmittance, depth 1) against AplusSampleTable on tables of random
+    // texels, every mapping, altitudes on and between the rows (the ground row
+    // with rays below the horizon included): the same bits.
+    std::mt19937 rng(19);
+    std::uniform_real_distribution<float> texel(0.0f, 1.0f);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (const auto kind : {AplusParameterization::kLinear, AplusParameterization::kNonlinear,
+                            AplusParameterization::kHorizon, AplusParameterization::kPower}) {
+        const AplusMapping m = MakeMapping(kind);
+        Table scattering(6, 9, 5, 4), transmittance(7, 11, 1, 3);
+        for (Table* t : {&scattering, &transmittance}) {
+            const size_t n = static_cast<size_t>(t->width()) * t->height() * t->depth() *
+                             static_cast<size_t>(t->channels());
+            for (size_t i = 0; i < n; ++i) t->data()[i] = texel(rng);
+        }
+        Vec4f one;
+        one.x = one.y = one.z = 1.0f;
+        const float zero4[4] = {0.0f, 0.0f, 0.0f, 0.0f}, one3[3] = {1.0f, 1.0f, 1.0f};
+        for (int q = 0; q < 2000; ++q) {
+            const double h = q % 7 == 0 ? 0.0 : m.height * u(rng) * u(rng);
+            const double mu = 2.0 * u(rng) - 1.0, w = u(rng);
+            const Vec4f a = AplusSampleTable(scattering.view(), m, h, mu, w, Vec4f());
+            float b[4];
+            AplusSampleTableFixed<4>(scattering.view(), m, h, mu, w, zero4, b);
+            EXPECT_EQ(std::memcmp(&a.x, &b[0], sizeof(float)), 0) << h << " " << mu;
+            EXPECT_EQ(std::memcmp(&a.y, &b[1], sizeof(float)), 0) << h << " " << mu;
+            EXPECT_EQ(std::memcmp(&a.z, &b[2], sizeof(float)), 0) << h << " " << mu;
+            EXPECT_EQ(std::memcmp(&a.w, &b[3], sizeof(float)), 0) << h << " " << mu;
+            const Rgb ta = AplusSampleTable(transmittance.view(), m, h, mu, 0.5, one).rgb();
+            float tb[3];
+            AplusSampleTableFixed<3>(transmittance.view(), m, h, mu, 0.5, one3, tb);
+            EXPECT_EQ(std::memcmp(&ta.x, &tb[0], sizeof(float)), 0) << h << " " << mu;
+            EXPECT_EQ(std::memcmp(&ta.y, &tb[1], sizeof(float)), 0) << h << " " << mu;
+            EXPECT_EQ(std::memcmp(&ta.z, &tb[2], sizeof(float)), 0) << h << " " << mu;
+        }
     }
 }
 

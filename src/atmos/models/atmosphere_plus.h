@@ -272,6 +272,46 @@ ATMOS_HD inline Rgb AplusSampleTransmittance(const TableView& t, const AplusMapp
     return AplusSampleTable(t, m, h, mu, 0.5, one).rgb();
 }
 
+// AplusSampleTable for a table of C channels (TableView::channels == C): the
+// same operations in the same order on the texels read directly (no per-texel
+// clamps or channel tests; base/texture.h's TexelSpan), hence bit-identical
+// (tests/atmosphere_plus_test.cpp holds it to the generic one).
+template <int C>
+ATMOS_HD inline void AplusSampleTableFixed(const TableView& t, const AplusMapping& m, double h,
+                                           double mu, double w, const float ground_row[C],
+                                           float out[C]) {
+    ATMOS_DASSERT(t.channels == C);
+    const TexelSpan x = SplitSpan(GetTextureCoordFromUnitRange(m.U(h), t.width), t.width);
+    const TexelSpan z = SplitSpan(w, t.depth);
+    const size_t plane = static_cast<size_t>(t.width) * t.height;
+    for (int c = 0; c < C; ++c) out[c] = 0.0f;
+    for (int k = 0; k < 2; ++k) {
+        const float weight = k == 0 ? 1.0f - x.f : x.f;
+        if (weight == 0.0f) continue;
+        const int xi = k == 0 ? x.i0 : x.i1;
+        const double h_row = m.H(t.width > 1 ? static_cast<double>(xi) / (t.width - 1) : 0.0);
+        if (h_row <= 0.0 && mu < 0.0) {
+            for (int c = 0; c < C; ++c) out[c] = out[c] + ground_row[c] * weight;
+            continue;
+        }
+        const TexelSpan y =
+            SplitSpan(GetTextureCoordFromUnitRange(m.V(h_row, mu), t.height), t.height);
+        const size_t y0 = static_cast<size_t>(y.i0) * t.width + xi;
+        const size_t y1 = static_cast<size_t>(y.i1) * t.width + xi;
+        const size_t z0 = static_cast<size_t>(z.i0) * plane, z1 = static_cast<size_t>(z.i1) * plane;
+        const float* d = t.data;
+        for (int c = 0; c < C; ++c) {
+            const float l0 = d[(z0 + y0) * C + c] * (1.0f - y.f) + d[(z0 + y1) * C + c] * y.f;
+            float row = l0;
+            if (t.depth > 1) {
+                const float l1 = d[(z1 + y0) * C + c] * (1.0f - y.f) + d[(z1 + y1) * C + c] * y.f;
+                row = l0 * (1.0f - z.f) + l1 * z.f;
+            }
+            out[c] = out[c] + row * weight;
+        }
+    }
+}
+
 // The per-pixel evaluator (trivially copyable; tables by view).
 struct AtmospherePlusEvaluator {
     AtmosphereParameters atm;
@@ -287,6 +327,14 @@ struct AtmospherePlusEvaluator {
         v(transmittance);
     }
 
+    // AplusSampleTransmittance on the fixed 3-channel lookup (bit-identical).
+    ATMOS_HD Rgb Transmittance(double h, double mu) const {
+        const float one[3] = {1.0f, 1.0f, 1.0f};
+        float t[3];
+        AplusSampleTableFixed<3>(transmittance, mapping, h, mu, 0.5, one, t);
+        return Rgb(t[0], t[1], t[2]);
+    }
+
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                 bool want_ground) const {
         RayResult out;
@@ -296,8 +344,8 @@ struct AtmospherePlusEvaluator {
             if (want_ground && GroundAtCamera(seg) && MaxComponent(atm.ground_albedo) > 0.0) {
                 const double cos_sun = Dot(Normalize(camera), sun);
                 if (cos_sun > 0.0) {
-                    out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi)) *
-                                 AplusSampleTransmittance(transmittance, mapping, 0.0, cos_sun);
+                    out.ground =
+                        Rgb(atm.ground_albedo * (cos_sun / kPi)) * Transmittance(0.0, cos_sun);
                 }
             }
             return out;
@@ -309,7 +357,16 @@ struct AtmospherePlusEvaluator {
         const double mu = ClampCosine(Dot(p0, dir) / r);
         const double mu_s = ClampCosine(Dot(p0, sun) / r);
         const double nu = ClampCosine(Dot(dir, sun));
-        const Vec4f s = AplusSample(scattering, mapping, h, mu, mu_s);
+        const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        float s4[4];
+        AplusSampleTableFixed<4>(scattering, mapping, h, mu,
+                                 GetTextureCoordFromUnitRange(mapping.W(mu_s), scattering.depth),
+                                 zero, s4);
+        Vec4f s;
+        s.x = s4[0];
+        s.y = s4[1];
+        s.z = s4[2];
+        s.w = s4[3];
         // Seed 000 2.3: I_S / I_I = F_R(dot(L, -V)) I_R + F_M(dot(L, -V)) I_M, with
         // L = -sun and so dot(L, -V) = dot(sun, V) = nu.
         const double f_r =
@@ -317,12 +374,12 @@ struct AtmospherePlusEvaluator {
         const double f_m = AplusMiePhase(atm.mie_phase_g, nu);
         const Rgb sky = s.rgb() * static_cast<float>(f_r) + Rgb(s.w * static_cast<float>(f_m));
         out.sky = Max(sky, Rgb(0.0f));
-        out.transmittance = AplusSampleTransmittance(transmittance, mapping, h, mu);
+        out.transmittance = Transmittance(h, mu);
         if (want_ground && seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0) {
             const Vec3d g = camera + dir * seg.t_end;
             const double cos_sun = Dot(Normalize(g), sun);
             if (cos_sun > 0.0) {
-                const Rgb t_sun = AplusSampleTransmittance(transmittance, mapping, 0.0, cos_sun);
+                const Rgb t_sun = Transmittance(0.0, cos_sun);
                 out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi)) * t_sun * out.transmittance;
             }
         }

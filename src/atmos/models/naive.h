@@ -34,6 +34,7 @@
 #include "physics/geometry.h"
 #include "physics/phase.h"
 #include "physics/single_scattering.h"
+#include "physics/vector_exp.h"
 
 namespace atmos {
 
@@ -42,35 +43,151 @@ struct NaiveEvaluator {
     int steps = 16;       // primary (view) ray samples
     int light_steps = 8;  // light ray samples
 
-    // Extinction (per channel) and the Rayleigh and Mie densities at an altitude.
-    ATMOS_HD Vec3d ExtinctionAt(double altitude, double* rho_r, double* rho_m) const {
-        const Densities d = GetDensities(atm, altitude);
-        *rho_r = d.rayleigh;
-        *rho_m = d.mie;
-        return Extinction(atm, d);
-    }
-
     // Optical depth (per channel) from `p` to the top of the atmosphere toward
     // the sun, by `light_steps` midpoint samples, or false if that ray hits the
-    // ground.
+    // ground. The three densities are summed over the samples, then weighted by
+    // the coefficients once. The samples go in blocks of kLightLanes (a vector
+    // loop: the altitude |p + t s| - R = sqrt(r^2 + t (2 r mu_s + t)) - R, the
+    // densities on ExpLane, none for a profile without an exponential); the
+    // last block's lanes past light_steps weigh 0.
+    static constexpr int kLightLanes = 4;
+    // The three profiles as LaneProfile (once per ray, not per light ray).
+    struct Profiles {
+        LaneProfile rayleigh, mie, ozone;
+        ATMOS_HD explicit Profiles(const AtmosphereParameters& a)
+            : rayleigh(a.rayleigh_density), mie(a.mie_density), ozone(a.absorption_density) {}
+    };
     ATMOS_HD bool LightDepth(const Vec3d& p, const Vec3d& sun, Vec3d* tau) const {
+        return LightDepth(Profiles(atm), p, sun, tau);
+    }
+    ATMOS_HD bool LightDepth(const Profiles& prof, const Vec3d& p, const Vec3d& sun,
+                             Vec3d* tau) const {
         const double r = Length(p);
         const double mu_s = ClampCosine(Dot(p, sun) / r);
         if (RayIntersectsGround(r, mu_s, atm.bottom_radius)) return false;
         const double length = DistanceToTopAtmosphereBoundary(r, mu_s, atm.top_radius);
         const double ds = length / light_steps;
-        Vec3d sum;
-        for (int j = 0; j < light_steps; ++j) {
-            const Vec3d q = p + sun * ((j + 0.5) * ds);
-            sum += Extinction(atm, GetDensities(atm, Length(q) - atm.bottom_radius));
+        const double r2 = r * r;
+        const double b = 2.0 * r * mu_s;
+        double d_r, d_m, d_o;
+        if (prof.ozone.any_exp) {
+            LightSums<true>(prof, r2, b, ds, &d_r, &d_m, &d_o);
+        } else {
+            LightSums<false>(prof, r2, b, ds, &d_r, &d_m, &d_o);
         }
-        *tau = sum * ds;
+        *tau = Extinction(atm, Densities{d_r * ds, d_m * ds, d_o * ds});
         return true;
     }
 
+    // The light ray's density sums (LightDepth); kOzoneExp: whether the
+    // absorption profile has an exponential term.
+    template <bool kOzoneExp>
+    ATMOS_HD void LightSums(const Profiles& prof, double r2, double b, double ds, double* d_r,
+                            double* d_m, double* d_o) const {
+        const double bottom = atm.bottom_radius;
+        const int n = light_steps;
+        const LaneProfile rayleigh = prof.rayleigh, mie = prof.mie, ozone = prof.ozone;
+        double sum_r[kLightLanes] = {}, sum_m[kLightLanes] = {}, sum_o[kLightLanes] = {};
+        // k + 0.5 per lane, as doubles (an int lane index keeps GCC at 2-lane vectors).
+        const double half[kLightLanes] = {0.5, 1.5, 2.5, 3.5};
+        for (int j0 = 0; j0 < n; j0 += kLightLanes) {
+            const double jd = j0, nd = n;
+            ATMOS_SIMD
+            for (int k = 0; k < kLightLanes; ++k) {
+                const double j = jd + half[k];
+                const double t = j * ds;
+                const double h = SafeSqrt(r2 + t * (b + t)) - bottom;
+                const double w = j < nd ? 1.0 : 0.0;  // j + 0.5 < n: j < n
+                sum_r[k] += w * rayleigh.Density<true>(h);
+                sum_m[k] += w * mie.Density<true>(h);
+                sum_o[k] += w * ozone.Density<kOzoneExp>(h);
+            }
+        }
+        static_assert(kLightLanes == 4, "the pairwise sums below");
+        *d_r = (sum_r[0] + sum_r[1]) + (sum_r[2] + sum_r[3]);
+        *d_m = (sum_m[0] + sum_m[1]) + (sum_m[2] + sum_m[3]);
+        *d_o = (sum_o[0] + sum_o[1]) + (sum_o[2] + sum_o[3]);
+    }
+
+    // The densities at the midpoints of view steps i0 .. i0 + kLightLanes - 1
+    // (the altitude as Length(camera + dir t) - R: the same operations).
+    template <bool kOzoneExp>
+    ATMOS_HD void ViewDensities(const Profiles& prof, const Vec3d& camera, const Vec3d& dir,
+                                double t_start, int i0, double ds, double* rho_r, double* rho_m,
+                                double* rho_o) const {
+        const double bottom = atm.bottom_radius;
+        const LaneProfile rayleigh = prof.rayleigh, mie = prof.mie, ozone = prof.ozone;
+        const double i0d = i0;
+        const double half[kLightLanes] = {0.5, 1.5, 2.5, 3.5};
+        ATMOS_SIMD
+        for (int k = 0; k < kLightLanes; ++k) {
+            const double t = t_start + (i0d + half[k]) * ds;
+            const double px = camera.x + dir.x * t, py = camera.y + dir.y * t,
+                         pz = camera.z + dir.z * t;
+            const double h = Sqrt(px * px + py * py + pz * pz) - bottom;
+            rho_r[k] = rayleigh.Density<true>(h);
+            rho_m[k] = mie.Density<true>(h);
+            rho_o[k] = ozone.Density<kOzoneExp>(h);
+        }
+    }
+
+    // IntegrateSingleScattering (physics/single_scattering.h) with the view
+    // samples in blocks of kLightLanes: their densities and then their
+    // transmittances exp(-(tau_view + tau_sun)) per channel are vector loops
+    // (ExpLane); the optical depths accumulate in the same order. A sample in
+    // the planet's shadow gets tau = inf (transmittance 0).
     ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                 bool want_ground) const {
-        return IntegrateSingleScattering(atm, *this, steps, camera, dir, sun, want_ground);
+        RayResult out;
+        AtmosphereSegment seg;
+        if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) {
+            SingleScatteringGroundAtCamera(atm, *this, camera, sun, seg, want_ground, &out);
+            return out;
+        }
+        constexpr int kL = kLightLanes;
+        const double inf = HUGE_VAL;
+        const double ds = (seg.t_end - seg.t_start) / steps;
+        const Profiles prof(atm);
+        Vec3d tau_view;  // camera to the start of the current step
+        Vec3d sum_r, sum_m;
+        for (int i0 = 0; i0 < steps; i0 += kL) {
+            double rho_r[kL], rho_m[kL], rho_o[kL], tau[3][kL];
+            if (prof.ozone.any_exp) {
+                ViewDensities<true>(prof, camera, dir, seg.t_start, i0, ds, rho_r, rho_m, rho_o);
+            } else {
+                ViewDensities<false>(prof, camera, dir, seg.t_start, i0, ds, rho_r, rho_m, rho_o);
+            }
+            const int lanes = Min(kL, steps - i0);
+            for (int k = 0; k < kL; ++k) {
+                if (k >= lanes) {
+                    tau[0][k] = tau[1][k] = tau[2][k] = inf;
+                    continue;
+                }
+                const Vec3d ext = Extinction(atm, Densities{rho_r[k], rho_m[k], rho_o[k]});
+                const Vec3d tau_mid = tau_view + ext * (0.5 * ds);
+                tau_view += ext * ds;
+                const Vec3d p = camera + dir * (seg.t_start + (i0 + k + 0.5) * ds);
+                Vec3d tau_sun;
+                const Vec3d total =
+                    LightDepth(prof, p, sun, &tau_sun) ? tau_mid + tau_sun : Vec3d(inf);
+                tau[0][k] = total.x;
+                tau[1][k] = total.y;
+                tau[2][k] = total.z;
+            }
+            double tr[3][kL];
+            for (int c = 0; c < 3; ++c) {
+                ATMOS_SIMD
+                for (int k = 0; k < kL; ++k) tr[c][k] = ExpLane(-tau[c][k]);
+            }
+            for (int k = 0; k < lanes; ++k) {
+                const Vec3d t(tr[0][k], tr[1][k], tr[2][k]);
+                sum_r += t * (rho_r[k] * ds);
+                sum_m += t * (rho_m[k] * ds);
+            }
+        }
+        FinishSingleScattering(atm, *this, camera, dir, sun, seg, want_ground, sum_r, sum_m,
+                               tau_view, &out);
+        return out;
     }
 };
 

@@ -22,6 +22,47 @@
 
 namespace atmos {
 
+// A camera on the ground looking down (physics/ray.h, BeginRay false): the
+// ground at the camera, lit by the direct sun.
+template <typename Medium>
+ATMOS_HD inline void SingleScatteringGroundAtCamera(const AtmosphereParameters& atm,
+                                                    const Medium& medium, const Vec3d& camera,
+                                                    const Vec3d& sun, const AtmosphereSegment& seg,
+                                                    bool want_ground, RayResult* out) {
+    if (want_ground && GroundAtCamera(seg) && MaxComponent(atm.ground_albedo) > 0.0) {
+        const double cos_sun = Dot(Normalize(camera), sun);
+        Vec3d tau_sun;
+        if (cos_sun > 0.0 && medium.LightDepth(camera, sun, &tau_sun)) {
+            out->ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * Exp(-tau_sun));
+        }
+    }
+}
+
+// After the march: the sky from the phase-weighted sums, the transmittance
+// exp(-tau_view), and the ground (albedo a) lit by the direct sun only:
+// a / pi max(0, n.s) T_sun T_view.
+template <typename Medium>
+ATMOS_HD inline void FinishSingleScattering(const AtmosphereParameters& atm, const Medium& medium,
+                                            const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                                            const AtmosphereSegment& seg, bool want_ground,
+                                            const Vec3d& sum_r, const Vec3d& sum_m,
+                                            const Vec3d& tau_view, RayResult* out) {
+    const double nu = Dot(dir, sun);
+    const Vec3d sky = atm.rayleigh_scattering * sum_r * RayleighPhase(nu) +
+                      atm.mie_scattering * sum_m * CornetteShanksPhase(atm.mie_phase_g, nu);
+    const Vec3d t_view = Exp(-tau_view);
+    out->sky = Rgb(sky);
+    out->transmittance = Rgb(t_view);
+    if (want_ground && seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0) {
+        const Vec3d g = camera + dir * seg.t_end;
+        const double cos_sun = Dot(Normalize(g), sun);
+        Vec3d tau_sun;
+        if (cos_sun > 0.0 && medium.LightDepth(g, sun, &tau_sun)) {
+            out->ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * Exp(-tau_sun) * t_view);
+        }
+    }
+}
+
 template <typename Medium>
 ATMOS_HD inline RayResult IntegrateSingleScattering(const AtmosphereParameters& atm,
                                                     const Medium& medium, int steps,
@@ -30,18 +71,10 @@ ATMOS_HD inline RayResult IntegrateSingleScattering(const AtmosphereParameters& 
     RayResult out;
     AtmosphereSegment seg;
     if (!BeginRay(camera, dir, atm.bottom_radius, atm.top_radius, &out, &seg)) {
-        // A camera on the ground looking down (physics/ray.h): the ground at the camera.
-        if (want_ground && GroundAtCamera(seg) && MaxComponent(atm.ground_albedo) > 0.0) {
-            const double cos_sun = Dot(Normalize(camera), sun);
-            Vec3d tau_sun;
-            if (cos_sun > 0.0 && medium.LightDepth(camera, sun, &tau_sun)) {
-                out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * Exp(-tau_sun));
-            }
-        }
+        SingleScatteringGroundAtCamera(atm, medium, camera, sun, seg, want_ground, &out);
         return out;
     }
     const double ds = (seg.t_end - seg.t_start) / steps;
-    const double nu = Dot(dir, sun);
     Vec3d tau_view;  // camera to the start of the current step
     Vec3d sum_r, sum_m;
     for (int i = 0; i < steps; ++i) {
@@ -56,20 +89,8 @@ ATMOS_HD inline RayResult IntegrateSingleScattering(const AtmosphereParameters& 
         sum_r += t * (rho_r * ds);
         sum_m += t * (rho_m * ds);
     }
-    const Vec3d sky = atm.rayleigh_scattering * sum_r * RayleighPhase(nu) +
-                      atm.mie_scattering * sum_m * CornetteShanksPhase(atm.mie_phase_g, nu);
-    const Vec3d t_view = Exp(-tau_view);
-    out.sky = Rgb(sky);
-    out.transmittance = Rgb(t_view);
-    // The ground (albedo a) lit by the direct sun only: a / pi max(0, n.s) T_sun T_view.
-    if (want_ground && seg.hits_ground && MaxComponent(atm.ground_albedo) > 0.0) {
-        const Vec3d g = camera + dir * seg.t_end;
-        const double cos_sun = Dot(Normalize(g), sun);
-        Vec3d tau_sun;
-        if (cos_sun > 0.0 && medium.LightDepth(g, sun, &tau_sun)) {
-            out.ground = Rgb(atm.ground_albedo * (cos_sun / kPi) * Exp(-tau_sun) * t_view);
-        }
-    }
+    FinishSingleScattering(atm, medium, camera, dir, sun, seg, want_ground, sum_r, sum_m, tau_view,
+                           &out);
     return out;
 }
 
