@@ -80,7 +80,7 @@ struct AtmosphereSegment {
 ATMOS_HD inline AtmosphereSegment ClipToAtmosphere(const Vec3d& camera, const Vec3d& dir,
                                                    double bottom, double top) {
     AtmosphereSegment seg;
-    double top0, top1;
+    double top0 = 0.0, top1 = 0.0;  // set by IntersectSphere when it hits (GCC -O3 cannot tell)
     if (!IntersectSphere(camera, dir, top, &top0, &top1) || top1 <= 0.0) return seg;
     seg.t_start = Max(top0, 0.0);
     seg.t_end = top1;
