@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -519,10 +520,13 @@ TEST(Cli, SigintInsideAPassCheckpointsAndResumesToTheSameImage) {
     const Result full = RunAtmos(base + "-o " + (dir / "full.exr").string());
     ASSERT_EQ(full.status, 0) << full.err;
     const std::string renames = "rename,renameat,renameat2";
-    const std::string cmd = "strace -f -o /dev/null -e trace=" + renames + " -e inject=" + renames +
-                            ":signal=SIGINT:when=3 " + ATMOS_CLI_PATH + " " + base + "-o " +
-                            (dir / "cut.exr").string() + " > /dev/null 2> " +
-                            (dir / "err").string();
+    // LeakSanitizer cannot run under ptrace: off for the traced run (the
+    // process exits normally here, unlike the kill tests).
+    const std::string cmd =
+        "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0\" strace -f -o /dev/null -e "
+        "trace=" +
+        renames + " -e inject=" + renames + ":signal=SIGINT:when=3 " + ATMOS_CLI_PATH + " " + base +
+        "-o " + (dir / "cut.exr").string() + " > /dev/null 2> " + (dir / "err").string();
     const int raw = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(raw));
     EXPECT_EQ(WEXITSTATUS(raw), 2);
@@ -710,23 +714,38 @@ TEST(Cli, TextOutputsAreWrittenAtomically) {
     fs::remove_all(dir);
     fs::create_directories(dir);
     const fs::path data = fs::path(ATMOS_SOURCE_DIR) / "tests" / "data" / "kider-2013";
-    const std::pair<std::string, fs::path> cases[] = {
+    // 40 queries for sample's CSV outputs (each over 1 KiB).
+    {
+        std::ofstream q(dir / "q.csv");
+        q << "altitude_m,mu,mu_s,azimuth_deg\n";
+        for (int i = 0; i < 40; ++i) q << 100 * i << "," << 0.02 * i - 0.3 << ",0.5,30\n";
+    }
+    const std::string queries = " --input " + (dir / "q.csv").string() + " --output ";
+    // Each command, its output checked, and the file-size limit (KiB) it runs under.
+    const std::tuple<std::string, fs::path, int> cases[] = {
         {"validate kider-2013 -q --models naive --data " + data.string() + " -o " +
              (dir / "v.csv").string(),
-         dir / "v.csv"},
+         dir / "v.csv", 1},
         {"compare --models naive --reference flat --views ground-noon --size 8x4 --quiet "
          "--no-npy -o " +
              (dir / "cmp").string(),
-         dir / "cmp" / "index.html"},
+         dir / "cmp" / "index.html", 1},
+        {"sample --model naive" + queries + (dir / "s.csv").string(), dir / "s.csv", 1},
+        {"sample --model naive --wavelengths 400:700:4" + queries + (dir / "w.csv").string(),
+         dir / "w.csv", 1},
+        // hillaire's bake: its EXR tables (at most 180 KB) fit under the limit,
+        // tables.f32 (208,896 B) does not.
+        {"bake -q --model hillaire -o " + (dir / "bake").string(), dir / "bake" / "tables.f32",
+         190},
     };
-    for (const auto& [args, target] : cases) {
+    for (const auto& [args, target, limit_kib] : cases) {
         const Result first = RunAtmos(args);
         ASSERT_EQ(first.status, 0) << args << "\n" << first.err;
         const std::string before = Slurp(target);
         ASSERT_GT(before.size(), 1024u) << target;
-        const std::string cmd = "bash -c \"trap '' XFSZ; ulimit -f 1; exec " +
-                                std::string(ATMOS_CLI_PATH) + " " + args + "\" > /dev/null 2> " +
-                                (dir / "err").string();
+        const std::string cmd = "bash -c \"trap '' XFSZ; ulimit -f " + std::to_string(limit_kib) +
+                                "; exec " + std::string(ATMOS_CLI_PATH) + " " + args +
+                                "\" > /dev/null 2> " + (dir / "err").string();
         const int raw = std::system(cmd.c_str());
         ASSERT_TRUE(WIFEXITED(raw)) << args;
         EXPECT_EQ(WEXITSTATUS(raw), 2) << args;

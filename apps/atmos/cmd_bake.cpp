@@ -37,9 +37,7 @@ std::string ShaderAsset(const std::string& model) {
 constexpr const char* kCommonShader = "shaders/common.glsl";
 
 void WriteText(const fs::path& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    if (!out) Fail("cannot write '", path.string(), "'");
+    WriteFileAtomically(path.string(), text);
 }
 
 std::string ReadFile(const fs::path& path) {

@@ -23,6 +23,7 @@
 #include "cli_monte_carlo.h"
 #include "harness/gallery.h"
 #include "io/image_formats.h"
+#include "io/output_path.h"
 #include "render/progressive.h"
 #include "sample_spectral.h"
 
@@ -194,17 +195,12 @@ void WriteAnswers(const std::string& output, const std::vector<SampleQuery>& que
         return;
     }
     const std::string text = FormatAnswersCsv(queries, answers);
-    std::FILE* f = stdout;
     if (!output.empty() && output != "-") {
-        f = std::fopen(output.c_str(), "wb");
-        if (f == nullptr) Fail("cannot write '", output, "': ", std::strerror(errno));
+        WriteFileAtomically(output, text);  // a temporary file and one rename
+        return;
     }
-    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    if (f != stdout) {
-        if (std::fclose(f) != 0 || !ok) Fail("cannot write '", output, "'");
-    } else if (!ok || std::fflush(f) != 0) {
-        Fail("cannot write the answers to stdout");
-    }
+    const bool ok = std::fwrite(text.data(), 1, text.size(), stdout) == text.size();
+    if (!ok || std::fflush(stdout) != 0) Fail("cannot write the answers to stdout");
 }
 
 struct SampleIo {

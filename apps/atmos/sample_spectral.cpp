@@ -6,6 +6,7 @@
 // irradiance, no sun disc, no ground; W m^-2 sr^-1 nm^-1 for a solar spectrum in
 // W m^-2 nm^-1), then X, Y, Z: 683 lm/W times the CIE 1931 integral over the given
 // bins (cd m^-2 for those units).
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -16,6 +17,7 @@
 #include "cli_common.h"
 #include "harness/spectral_run.h"
 #include "io/image_formats.h"
+#include "io/output_path.h"
 #include "sample_spectral.h"
 
 namespace atmos::cli {
@@ -45,28 +47,38 @@ int SampleSpectralCsv(const CommonOptions& common, const MonteCarloSettings& mon
         detail::WriteNpyArray(output, {queries.size(), n + 3}, array.data());
         return 0;
     }
-    std::FILE* f = stdout;
-    if (!output.empty() && output != "-") {
-        f = std::fopen(output.c_str(), "wb");
-        if (f == nullptr) Fail("cannot write '", output, "'");
-    }
-    std::string header = "altitude_m,mu,mu_s,azimuth_deg";
-    for (double l : nm) header += ",L_" + WavelengthLabel(l);
-    std::fprintf(f, "%s,X,Y,Z\n", header.c_str());
+    // The CSV in memory, then to stdout or through a temporary file and one
+    // rename (a failed write never leaves a truncated file).
+    std::string text;
+    char cell[64];
+    // A number as printf's %.17g (the query's inputs) or %.9g (float outputs).
+    const auto put = [&](bool comma, bool full_precision, double v) {
+        if (comma) text += ',';
+        const int len = full_precision ? std::snprintf(cell, sizeof cell, "%.17g", v)
+                                       : std::snprintf(cell, sizeof cell, "%.9g", v);
+        text.append(cell, static_cast<size_t>(std::max(len, 0)));
+    };
+    text += "altitude_m,mu,mu_s,azimuth_deg";
+    for (double l : nm) text += ",L_" + WavelengthLabel(l);
+    text += ",X,Y,Z\n";
     for (size_t q = 0; q < queries.size(); ++q) {
-        std::fprintf(f, "%.17g,%.17g,%.17g,%.17g", queries[q].altitude_m, queries[q].mu,
-                     queries[q].mu_s, queries[q].azimuth_deg);
-        for (size_t i = 0; i < n; ++i) std::fprintf(f, ",%.9g", values[q * n + i]);
+        put(false, true, queries[q].altitude_m);
+        put(true, true, queries[q].mu);
+        put(true, true, queries[q].mu_s);
+        put(true, true, queries[q].azimuth_deg);
+        for (size_t i = 0; i < n; ++i) put(true, false, values[q * n + i]);
         const Vec3d xyz = SpectrumToXyz(nm, weights, values.data() + q * n);
-        std::fprintf(f, ",%.9g,%.9g,%.9g\n", kMaxLuminousEfficacy * xyz.x,
-                     kMaxLuminousEfficacy * xyz.y, kMaxLuminousEfficacy * xyz.z);
+        put(true, false, kMaxLuminousEfficacy * xyz.x);
+        put(true, false, kMaxLuminousEfficacy * xyz.y);
+        put(true, false, kMaxLuminousEfficacy * xyz.z);
+        text += "\n";
     }
-    const bool ok = std::ferror(f) == 0;
-    if (f != stdout) {
-        if (std::fclose(f) != 0 || !ok) Fail("cannot write '", output, "'");
-    } else if (!ok || std::fflush(f) != 0) {
-        Fail("cannot write the spectral columns to stdout");
+    if (!output.empty() && output != "-") {
+        WriteFileAtomically(output, text);
+        return 0;
     }
+    const bool ok = std::fwrite(text.data(), 1, text.size(), stdout) == text.size();
+    if (!ok || std::fflush(stdout) != 0) Fail("cannot write the spectral columns to stdout");
     return 0;
 }
 

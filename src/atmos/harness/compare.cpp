@@ -556,7 +556,7 @@ CompareResult RunCompare(const CompareConfig& config) {
     }
     if (spectral_reference) {
         // What RGB costs: each model against the spectral and the RGB reference.
-        std::ofstream f(out / "rgb_cost.csv");
+        TextOutput f((out / "rgb_cost.csv").string());
         f << "view,model,flip_spectral_reference,flip_rgb_reference,difference\n";
         for (const CompareRow& row : result.rows) {
             for (size_t m = 0; m < result.models.size(); ++m) {
@@ -565,7 +565,7 @@ CompareResult RunCompare(const CompareConfig& config) {
                   << c.flip_rgb_reference << "," << c.flip - c.flip_rgb_reference << "\n";
             }
         }
-        if (!f) Fail("cannot write '", (out / "rgb_cost.csv").string(), "'");
+        f.Commit();
     }
     {
         TextOutput f((out / "times.csv").string());

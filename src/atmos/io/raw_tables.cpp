@@ -7,6 +7,7 @@
 #include <ostream>
 
 #include "atmos/error.h"
+#include "io/output_path.h"
 
 namespace atmos {
 
@@ -54,12 +55,16 @@ constexpr size_t kAlign = 256;
 
 size_t AlignUp(size_t n) { return (n + kAlign - 1) / kAlign * kAlign; }
 
+// Through a temporary file and one rename (io/output_path.h): a failed write
+// never leaves a truncated table file.
 void WriteFile(const std::string& path, const std::vector<unsigned char>& bytes) {
-    std::ofstream out(path, std::ios::binary);
-    if (!out) Fail("cannot write '", path, "'");
-    out.write(reinterpret_cast<const char*>(bytes.data()),
-              static_cast<std::streamsize>(bytes.size()));
-    if (!out) Fail("cannot write '", path, "'");
+    WriteThroughTemporary(path, [&](const std::string& temporary) {
+        std::ofstream out(temporary, std::ios::binary);
+        out.write(reinterpret_cast<const char*>(bytes.data()),
+                  static_cast<std::streamsize>(bytes.size()));
+        out.close();
+        if (!out) Fail("cannot write '", path, "'");
+    });
 }
 
 void PutLe(std::vector<unsigned char>* out, size_t at, uint32_t v, int bytes) {
@@ -151,9 +156,7 @@ nlohmann::ordered_json WriteGlslConstants(const std::string& directory, const st
     fs::create_directories(dir);
     const std::string constants = "shaders/" + stem + "_constants.glsl";
     const std::string path = (fs::path(directory) / constants).string();
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    if (!out) Fail("cannot write '", path, "'");
+    WriteFileAtomically(path, text);
     const std::string functions = "shaders/" + stem + ".glsl";
     nlohmann::ordered_json j;
     j["constants"] = constants;

@@ -14,6 +14,7 @@
 
 #include "atmos/error.h"
 #include "base/parallel.h"
+#include "io/output_path.h"
 #include "io/raw_tables.h"
 #include "io/table_io.h"
 #include "models/atmosphere_plus_stages.h"
@@ -279,9 +280,7 @@ void AtmospherePlusModel::Bake(const std::string& directory) const {
     j["raw"] = nlohmann::json::parse(WriteRawTables(directory, RawTables(tables_)).dump());
     j["shaders"] = nlohmann::json::parse(
         WriteGlslConstants(directory, "atmosphere_plus", GlslConstants(atm_, settings_)).dump());
-    std::ofstream out(fs::path(directory) / "atmosphere-plus.json");
-    out << j.dump(2) << "\n";
-    if (!out) Fail("atmosphere-plus: cannot write ", directory, "/atmosphere-plus.json");
+    WriteFileAtomically((fs::path(directory) / "atmosphere-plus.json").string(), j.dump(2) + "\n");
 }
 
 void AtmospherePlusModel::LoadBaked(const std::string& directory,

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "atmos/error.h"
+#include "io/output_path.h"
 #include "io/raw_tables.h"
 #include "io/table_io.h"
 #include "models/option_json.h"
@@ -232,10 +233,7 @@ void BrunetonModel::Bake(const std::string& directory) const {
     j["raw"] = WriteRawTables(directory, RawTables(tables_, config_));
     j["shaders"] = WriteGlslConstants(directory, "bruneton", GlslConstants(atm_, config_));
     const std::string path = (dir / kBakeJson).string();
-    std::ofstream out(path);
-    if (!out) Fail("cannot write '", path, "'");
-    out << j.dump(2) << "\n";
-    if (!out) Fail("cannot write '", path, "'");
+    WriteFileAtomically(path, j.dump(2) + "\n");
 }
 
 void BrunetonModel::LoadBaked(const std::string& directory,

@@ -13,6 +13,7 @@
 
 #include "atmos/error.h"
 #include "base/parallel.h"
+#include "io/output_path.h"
 #include "io/raw_tables.h"
 #include "io/table_io.h"
 #include "models/hillaire_stages.h"
@@ -347,9 +348,7 @@ void HillaireModel::Bake(const std::string& directory) const {
     j["shaders"] = nlohmann::json::parse(
         WriteGlslConstants(directory, "hillaire", HillaireGlslConstants(evaluator_.atm, options_))
             .dump());
-    std::ofstream f(fs::path(directory) / kBakeJson);
-    f << j.dump(2) << "\n";
-    if (!f) Fail("cannot write ", (fs::path(directory) / kBakeJson).string());
+    WriteFileAtomically((fs::path(directory) / kBakeJson).string(), j.dump(2) + "\n");
 }
 
 void HillaireModel::LoadBaked(const std::string& directory,
