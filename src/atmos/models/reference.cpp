@@ -152,7 +152,7 @@ BrunetonLut BuildReferenceGuideLut(const AtmosphereParameters& atm, Table* trans
     return lut;
 }
 
-Table SharedSunColumnTable(const AtmosphereParameters& atm) {
+std::shared_ptr<const Table> SharedSunColumnTable(const AtmosphereParameters& atm) {
     // The geometry: radii and the three density profiles (5 numbers per layer).
     std::vector<double> key = {atm.bottom_radius, atm.top_radius};
     for (const DensityProfile* p :
@@ -165,15 +165,15 @@ Table SharedSunColumnTable(const AtmosphereParameters& atm) {
     // The last few geometries (1.5 MB each; the batches of a run share one).
     constexpr size_t kKeep = 8;
     static std::mutex mutex;
-    static std::vector<std::pair<std::vector<double>, std::unique_ptr<Table>>> tables;
+    static std::vector<std::pair<std::vector<double>, std::shared_ptr<const Table>>> tables;
     std::lock_guard<std::mutex> lock(mutex);
     for (const auto& [k, table] : tables) {
-        if (k == key) return *table;
+        if (k == key) return table;
     }
     if (tables.size() >= kKeep) tables.erase(tables.begin());
-    tables.emplace_back(key, std::make_unique<Table>(BuildSunColumnTable(
+    tables.emplace_back(key, std::make_shared<const Table>(BuildSunColumnTable(
                                  atm, kSunTableMuSize, kSunTableRSize, kSunTableIntervals)));
-    return *tables.back().second;
+    return tables.back().second;
 }
 
 ModelInfo ReferenceModel::StaticInfo() {
@@ -271,8 +271,9 @@ void ReferenceModel::Prepare(const AtmosphereParameters& atmosphere) {
     std::lock_guard<std::mutex> lock(sun_table_mutex_);
     resident_.Reset();
     sun_table_ready_ = false;
-    sun_table_ = Table(2, 2, 1, 3);  // until built: a valid table for a device copy
-    evaluator_.sun_table.Set(sun_table_.view(), atmosphere);
+    // Until built: a valid table for a device copy.
+    sun_table_ = std::make_shared<const Table>(2, 2, 1, 3);
+    evaluator_.sun_table.Set(sun_table_->view(), atmosphere);
     // The model's evaluator never names an order-1 table (only a pass's copy
     // does, holding the table alive: Order1Table), so no copy of it can name
     // a freed one.
@@ -291,7 +292,7 @@ const ReferenceEvaluator& ReferenceModel::evaluator() const {
     std::lock_guard<std::mutex> lock(sun_table_mutex_);
     if (!sun_table_ready_ && evaluator_.estimator == ReferenceEstimator::kHybrid) {
         sun_table_ = SharedSunColumnTable(evaluator_.atm);
-        evaluator_.sun_table.Set(sun_table_.view(), evaluator_.atm);
+        evaluator_.sun_table.Set(sun_table_->view(), evaluator_.atm);
         if (evaluator_.guide_candidates > 0) {
             evaluator_.guide_lut =
                 BuildReferenceGuideLut(evaluator_.atm, &guide_transmittance_, &guide_scattering_);

@@ -158,10 +158,11 @@ struct SunTransmittanceTable {
 Table BuildSunColumnTable(const AtmosphereParameters& atm, int mu_size, int r_size,
                           int intervals = 512);
 // BuildSunColumnTable(atm, kSunTableMuSize, kSunTableRSize, kSunTableIntervals),
-// built once per geometry (radii and density profiles) in the process and copied
-// out: the batches of a spectral run differ in their coefficients only.
-// Thread-safe; the last few geometries are kept.
-Table SharedSunColumnTable(const AtmosphereParameters& atm);
+// built once per geometry (radii and density profiles) in the process and shared
+// (not copied): the batches of a spectral run differ in their coefficients only.
+// Thread-safe; the last few geometries are kept (a table stays alive while a
+// model holds it).
+std::shared_ptr<const Table> SharedSunColumnTable(const AtmosphereParameters& atm);
 // Optical depth from (r, mu) to the top boundary by composite Simpson with
 // `intervals` (even) intervals (what the table gives at its texels).
 Vec3d SunOpticalDepthQuadrature(const AtmosphereParameters& atm, double r, double mu,
@@ -1242,7 +1243,7 @@ class ReferenceModel : public MonteCarloModel {
 
     ModelInfo info_;
     mutable ReferenceEvaluator evaluator_;
-    mutable Table sun_table_;
+    mutable std::shared_ptr<const Table> sun_table_;
     mutable bool sun_table_ready_ = false;
     mutable std::mutex sun_table_mutex_;
     mutable ResidentTables resident_;  // the sun table's device copy (render/stages.h)
