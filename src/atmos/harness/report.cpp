@@ -586,6 +586,16 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
              "this reference: lower <code>--reference-noise</code> (or raise the cap) to rank "
              "those models.";
     }
+    std::string shipped_views;
+    for (const CompareRow& row : r.rows) {
+        if (row.reference_source == "shipped")
+            shipped_views += (shipped_views.empty() ? "" : ", ") + row.label;
+    }
+    if (!shipped_views.empty()) {
+        f << " Shipped references (not rendered in this run; their provenance, paths per pixel and "
+             "noise under each view's reference image): "
+          << HtmlEscape(shipped_views) << ".";
+    }
     f << "</p>\n";
     MetricTable(f,
                 transmittance ? "FLIP errors, transmittance (LDR-FLIP)" : "FLIP errors (HDR-FLIP)",
@@ -630,7 +640,12 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
         f << "<div class=\"row\">\n<figure><img src=\"" << HtmlEscape(row.reference_png)
           << "\" alt=\"reference\" title=\"reference, " << HtmlEscape(row.label)
           << "\"><figcaption><b>reference</b> (" << HtmlEscape(config.reference_model) << ")<br>"
-          << Fixed(row.reference_seconds, 3) + " s" << (row.reference_cached ? " (cached)" : "")
+          << (row.reference_source == "shipped"
+                  ? "shipped: " + HtmlEscape(row.reference_provenance) + "<br>" +
+                        std::to_string(row.reference_spp) + " paths per pixel, noise " +
+                        Fixed(row.reference_noise, 4)
+                  : Fixed(row.reference_seconds, 3) + " s" +
+                        (row.reference_cached ? " (cached)" : ""))
           << "</figcaption></figure>\n";
         for (size_t m = 0; m < row.cells.size(); ++m) {
             const CompareCell& c = row.cells[m];
