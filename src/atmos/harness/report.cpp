@@ -173,7 +173,13 @@ void TimeChart(std::ostream& f, const CompareConfig& config, const CompareResult
     f << "<p>Reference (" << HtmlEscape(config.reference_model)
       << "), apart from the chart: " << Duration(ref) << " per view"
       << (ref_cached ? " (cached: the original render's time)" : "");
-    if (hi > 0.0) f << ", " << General(ref / hi, 3) << "&times; the slowest model";
+    size_t shipped = 0;
+    for (const CompareRow& row : r.rows) shipped += row.reference_source == "shipped" ? 1 : 0;
+    if (shipped > 0) {
+        f << " (" << shipped << " of " << r.rows.size()
+          << " views shipped, not rendered: counted as 0 s)";
+    }
+    if (hi > 0.0 && ref > 0.0) f << ", " << General(ref / hi, 3) << "&times; the slowest model";
     f << ".</p>\n";
 }
 
