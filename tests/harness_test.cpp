@@ -610,6 +610,16 @@ TEST(Cli, CompareRendersWhenTheShippedReferenceIsStale) {
     EXPECT_EQ(
         Atmos(base + "--quantity transmittance --shipped-references " + set.string(), dir).status,
         2);
+    // The recorder: a malformed entry is one error line.
+    CliRun entry = Atmos("reference-provenance --views ground-noon --size 16x9 --record " +
+                             (dir / "rec").string() +
+                             " --entry '{\"view\":\"ground-noon\",\"paths_per_pixel\":0,"
+                             "\"noise\":0.1}'",
+                         dir);
+    EXPECT_EQ(entry.status, 2);
+    EXPECT_EQ(entry.err,
+              "atmos: error: reference-provenance --record: the entry: paths_per_pixel must be "
+              "positive and noise in [0, 1)\n");
 }
 
 // By default compare looks in data/references/WxH of the source tree when the

@@ -259,8 +259,11 @@ void RecordShippedView(const std::string& directory, const ReferenceFingerprint&
     }
     const std::string where = "reference-provenance --record: the entry";
     const std::string view = Field<std::string>(entry, "view", where);
-    Field<int64_t>(entry, "paths_per_pixel", where);
-    Field<double>(entry, "noise", where);
+    const int64_t paths = Field<int64_t>(entry, "paths_per_pixel", where);
+    const double noise = Field<double>(entry, "noise", where);
+    if (paths <= 0 || !(noise >= 0.0 && noise < 1.0)) {
+        Fail(where, ": paths_per_pixel must be positive and noise in [0, 1)");
+    }
     const auto hash = run.view_hashes.find(view);
     if (hash == run.view_hashes.end()) Fail(where, ": view '", view, "' is not one of --views");
     entry["view_hash"] = hash->second;
