@@ -1,6 +1,7 @@
 // atmos: shipped path-traced references (see shipped_references.h).
 #include "harness/shipped_references.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -245,6 +246,12 @@ void LoadShippedImages(const ShippedReferences& shipped, const std::string& view
         *out = ReadImage(path);
         if (out->width() != width || out->height() != height) {
             Fail(path, " is ", out->width(), "x", out->height(), ", not ", width, "x", height);
+        }
+        for (size_t i = 0; i < out->size(); ++i) {
+            const float x = out->data()[i];
+            if (!(std::isfinite(x) && x >= 0.0f)) {
+                Fail(path, " holds a NaN, infinite or negative value");
+            }
         }
     }
 }

@@ -98,7 +98,8 @@ std::string ShippedMismatch(const ShippedReferences& shipped, const ReferenceFin
                             const std::string& view, double noise_target, int64_t spp);
 
 // The shipped image and variance of `view` at the run's size (atmos::Error
-// when a file is missing, unreadable or of another size).
+// when a file is missing, unreadable, of another size or holds a NaN, infinite
+// or negative value).
 void LoadShippedImages(const ShippedReferences& shipped, const std::string& view, int width,
                        int height, Image* image, Image* variance);
 
