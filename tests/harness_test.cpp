@@ -483,8 +483,8 @@ TEST(ShippedReferences, UsedWhenAtLeastAsGoodAsTheRunsRender) {
 }
 
 // A shipped set made by scripts/make_references.sh (ground-noon, 16x9, to a
-// noise of 0.2: about a second); the script skips it when run again.
-fs::path MakeShippedSet(const fs::path& dir) {
+// noise of 0.2: about a second); `resume`: the script skips it when run again.
+fs::path MakeShippedSet(const fs::path& dir, bool resume = false) {
     const fs::path set = dir / "shipped";
     const std::string script = std::string("ATMOS=") + ATMOS_CLI_PATH + " " + ATMOS_SOURCE_DIR +
                                "/scripts/make_references.sh " + set.string() +
@@ -493,6 +493,7 @@ fs::path MakeShippedSet(const fs::path& dir) {
     EXPECT_EQ(made.status, 0) << made.err;
     EXPECT_NE(made.err.find("ground-noon: to render: no provenance"), std::string::npos)
         << made.err;
+    if (!resume) return set;
     CliRun again = Shell(script, dir);
     EXPECT_EQ(again.status, 0) << again.err;
     EXPECT_NE(again.err.find("ground-noon: shipped reference kept"), std::string::npos)
@@ -521,7 +522,7 @@ std::map<std::string, std::vector<std::string>> NoiseRows(const fs::path& csv) {
 // and says so in stderr, reference_noise.csv and the report; its noise ranks.
 TEST(Cli, CompareReadsAMatchingShippedReference) {
     const fs::path dir = TempDir("shipped-match");
-    const fs::path set = MakeShippedSet(dir);
+    const fs::path set = MakeShippedSet(dir, true);
     std::ifstream in(set / "provenance.json");
     const nlohmann::json provenance = nlohmann::json::parse(in);
     const nlohmann::json& entry = provenance.at("views").at(0);
@@ -595,6 +596,12 @@ TEST(Cli, CompareRendersWhenTheShippedReferenceIsStale) {
               std::string::npos)
         << bad;
     std::ofstream(set / "provenance.json") << provenance;
+    Image variance = ReadImage((set / "ground-noon.variance.exr").string());
+    variance.data()[5] = std::nanf("");
+    WriteImage(variance, (set / "ground-noon.variance.exr").string());
+    expect_line(run(""), "ground-noon: shipped reference not used: " +
+                             (set / "ground-noon.variance.exr").string() +
+                             " holds a NaN, infinite or negative value");
     fs::remove(set / "ground-noon.variance.exr");
     expect_line(run(""), "ground-noon: shipped reference not used: " +
                              (set / "ground-noon.variance.exr").string() + " is missing");
