@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
@@ -20,6 +21,7 @@
 #include "harness/compare.h"
 #include "harness/loc.h"
 #include "harness/render_cache.h"
+#include "harness/shipped_references.h"
 
 namespace fs = std::filesystem;
 
@@ -46,16 +48,20 @@ struct CliRun {
     int status = -1;
     std::string out, err;
 };
-CliRun Atmos(const std::string& args, const fs::path& dir) {
+// A shell command line, its stdout and stderr.
+CliRun Shell(const std::string& command, const fs::path& dir) {
     const fs::path out = dir / "stdout", err = dir / "stderr";
-    const std::string cmd =
-        std::string(ATMOS_CLI_PATH) + " " + args + " > " + out.string() + " 2> " + err.string();
+    const std::string cmd = command + " > " + out.string() + " 2> " + err.string();
     const int raw = std::system(cmd.c_str());
     CliRun r;
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
     r.out = Slurp(out);
     r.err = Slurp(err);
     return r;
+}
+
+CliRun Atmos(const std::string& args, const fs::path& dir) {
+    return Shell(std::string(ATMOS_CLI_PATH) + " " + args, dir);
 }
 
 // The last number printed on stdout.
@@ -310,13 +316,14 @@ TEST(Cli, CompareMeasuresTheReferencesNoise) {
     std::istringstream noise(noise_csv);
     std::string line;
     std::getline(noise, line);
-    EXPECT_EQ(line, "view,reference_noise_flip,half_spp,noise_target");
+    EXPECT_EQ(line, "view,reference_noise_flip,half_spp,noise_target,source,provenance");
     std::map<std::string, double> floor;
     while (std::getline(noise, line)) {
         std::vector<std::string> f;
         std::istringstream fields(line);
         for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
-        ASSERT_EQ(f.size(), 4u) << line;
+        ASSERT_EQ(f.size(), 5u) << line;  // the provenance (shipped only) is empty
+        EXPECT_EQ(f[4], "rendered");
         floor[f[0]] = std::stod(f[1]);
         EXPECT_EQ(f[2], "2");  // two halves of 2 spp
         EXPECT_EQ(f[3], "0");  // --reference-spp alone: no noise target
@@ -340,7 +347,11 @@ TEST(Cli, CompareMeasuresTheReferencesNoise) {
     CliRun again = Atmos(args, dir);
     ASSERT_EQ(again.status, 0) << again.err;
     EXPECT_NE(again.err.find("reference (reference) cached"), std::string::npos) << again.err;
-    EXPECT_EQ(Slurp(dir / "out" / "reference_noise.csv"), noise_csv);
+    std::string cached_csv = Slurp(dir / "out" / "reference_noise.csv");
+    for (size_t i = 0; (i = cached_csv.find(",cached,", i)) != std::string::npos;) {
+        cached_csv.replace(i, 8, ",rendered,");  // the source column says where it came from
+    }
+    EXPECT_EQ(cached_csv, noise_csv);
 }
 
 // A noise target: each view's reference renders until the FLIP between its
@@ -370,14 +381,14 @@ TEST(Cli, CompareRendersTheReferenceToANoiseTarget) {
     // Reachable: at or below the target, with more than the first pair of passes
     // somewhere (the first check is at 2 x 16 paths).
     for (const auto& f : run("0.2", "4096")) {
-        ASSERT_EQ(f.size(), 4u);
+        ASSERT_EQ(f.size(), 5u);
         EXPECT_LE(std::stod(f[1]), 0.2) << f[0];
         EXPECT_GE(std::stoll(f[2]), 8) << f[0];
         EXPECT_EQ(std::stod(f[3]), 0.2);
     }
     // Unreachable within the cap: stops at the cap, above the target.
     for (const auto& f : run("0.0001", "16")) {
-        ASSERT_EQ(f.size(), 4u);
+        ASSERT_EQ(f.size(), 5u);
         EXPECT_GT(std::stod(f[1]), 0.0001) << f[0];
         EXPECT_EQ(f[2], "8") << f[0];  // two halves of 8 paths
     }
@@ -414,6 +425,235 @@ TEST(Cli, CompareTakesModelVariants) {
         EXPECT_EQ(b.status, 2) << bad;
         EXPECT_NE(b.err.find("error"), std::string::npos) << bad << ": " << b.err;
     }
+}
+
+// Shipped references (harness/shipped_references.h, issue 16 item 4).
+
+// The fingerprint resolves what was rendered: default options spelled out or
+// not are the same render; an atmosphere field, another view, an option and
+// the size are not.
+TEST(ShippedReferences, FingerprintIdentifiesTheRender) {
+    const AtmosphereParameters earth = LoadAtmosphere("earth", {});
+    const std::vector<View> views = {GetView("ground-noon", earth), GetView("ground-dawn", earth)};
+    const ReferenceFingerprint a =
+        MakeReferenceFingerprint("reference", {}, "earth", earth, 16, 9, views);
+    const ReferenceFingerprint b = MakeReferenceFingerprint("reference", {{"estimator", "hybrid"}},
+                                                            "earth", earth, 16, 9, views);
+    EXPECT_EQ(a.model, b.model);
+    EXPECT_NE(a.model.find(":estimator=hybrid"), std::string::npos) << a.model;
+    EXPECT_EQ(a.atmosphere_hash, b.atmosphere_hash);
+    EXPECT_NE(a.view_hashes.at("ground-noon"), a.view_hashes.at("ground-dawn"));
+    const AtmosphereParameters albedo = LoadAtmosphere("earth", {"ground_albedo=0.31"});
+    const ReferenceFingerprint c =
+        MakeReferenceFingerprint("reference", {}, "earth", albedo, 16, 9, views);
+    EXPECT_NE(a.atmosphere_hash, c.atmosphere_hash);
+    const ReferenceFingerprint d =
+        MakeReferenceFingerprint("reference", {{"max-order", "4"}}, "earth", earth, 16, 9, views);
+    EXPECT_NE(a.model, d.model);
+    // A view is its camera and sun: moving the sun changes its hash.
+    View moved = views[0];
+    moved.sun_direction = Normalize(moved.sun_direction + Vec3d{0.0, 1e-9, 0.0});
+    EXPECT_NE(HashText(ViewFingerprintText(moved)), a.view_hashes.at("ground-noon"));
+}
+
+// The noise rule: a shipped image is used when its noise is at or below the
+// target, or it has at least the run's paths per pixel (cap or fixed count).
+TEST(ShippedReferences, UsedWhenAtLeastAsGoodAsTheRunsRender) {
+    const AtmosphereParameters earth = LoadAtmosphere("earth", {});
+    const ReferenceFingerprint run = MakeReferenceFingerprint("reference", {}, "earth", earth, 16,
+                                                              9, {GetView("ground-noon", earth)});
+    ShippedReferences shipped;
+    shipped.fingerprint = run;
+    shipped.views.push_back({"ground-noon", run.view_hashes.at("ground-noon"), 1024, 0.02, ""});
+    EXPECT_EQ(ShippedMismatch(shipped, run, "ground-noon", 0.02, 512), "");
+    EXPECT_EQ(ShippedMismatch(shipped, run, "ground-noon", 0.01, 1024), "");
+    EXPECT_EQ(ShippedMismatch(shipped, run, "ground-noon", 0.0, 1024), "");  // a fixed count
+    EXPECT_NE(ShippedMismatch(shipped, run, "ground-noon", 0.01, 2048).find("above the target"),
+              std::string::npos);
+    EXPECT_NE(ShippedMismatch(shipped, run, "ground-noon", 0.0, 2048), "");
+    EXPECT_EQ(ShippedMismatch(shipped, run, "ground-dawn", 0.02, 512),
+              "no shipped image of this view");
+    ReferenceFingerprint other = run;
+    other.estimator_version += 1;
+    other.width = 32;
+    EXPECT_EQ(ShippedMismatch(shipped, other, "ground-noon", 0.02, 512),
+              "estimator version differs (shipped " + std::to_string(run.estimator_version) +
+                  ", this build " + std::to_string(other.estimator_version) +
+                  "); size differs (shipped 16x9)");
+}
+
+// A shipped set made by scripts/make_references.sh (ground-noon, 16x9, to a
+// noise of 0.2: about a second); `resume`: the script skips it when run again.
+fs::path MakeShippedSet(const fs::path& dir, bool resume = false) {
+    const fs::path set = dir / "shipped";
+    const std::string script = std::string("ATMOS=") + ATMOS_CLI_PATH + " " + ATMOS_SOURCE_DIR +
+                               "/scripts/make_references.sh " + set.string() +
+                               " 16x9 0.2 64 ground-noon";
+    CliRun made = Shell(script, dir);
+    EXPECT_EQ(made.status, 0) << made.err;
+    EXPECT_NE(made.err.find("ground-noon: to render: no provenance"), std::string::npos)
+        << made.err;
+    if (!resume) return set;
+    CliRun again = Shell(script, dir);
+    EXPECT_EQ(again.status, 0) << again.err;
+    EXPECT_NE(again.err.find("ground-noon: shipped reference kept"), std::string::npos)
+        << again.err;
+    EXPECT_EQ(again.err.find("to render"), std::string::npos) << again.err;
+    return set;
+}
+
+// The reference_noise.csv rows (view -> fields).
+std::map<std::string, std::vector<std::string>> NoiseRows(const fs::path& csv) {
+    std::map<std::string, std::vector<std::string>> rows;
+    std::istringstream in(Slurp(csv));
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line, "view,reference_noise_flip,half_spp,noise_target,source,provenance");
+    while (std::getline(in, line)) {
+        std::vector<std::string> f;
+        std::istringstream fields(line);
+        for (std::string x; std::getline(fields, x, ',');) f.push_back(x);
+        if (!f.empty()) rows[f[0]] = f;
+    }
+    return rows;
+}
+
+// compare reads a matching shipped image instead of rendering the reference,
+// and says so in stderr, reference_noise.csv and the report; its noise ranks.
+TEST(Cli, CompareReadsAMatchingShippedReference) {
+    const fs::path dir = TempDir("shipped-match");
+    const fs::path set = MakeShippedSet(dir, true);
+    std::ifstream in(set / "provenance.json");
+    const nlohmann::json provenance = nlohmann::json::parse(in);
+    const nlohmann::json& entry = provenance.at("views").at(0);
+    CliRun r = Atmos(
+        "compare --models empty --views ground-noon --size 16x9 --reference-noise "
+        "0.2 --no-cache --shipped-references " +
+            set.string() + " -o " + (dir / "out").string(),
+        dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("reference (reference) shipped"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("reference (reference) rendered"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("not used"), std::string::npos) << r.err;
+    const auto rows = NoiseRows(dir / "out" / "reference_noise.csv");
+    ASSERT_EQ(rows.count("ground-noon"), 1u);
+    const std::vector<std::string>& f = rows.at("ground-noon");
+    ASSERT_EQ(f.size(), 6u);
+    EXPECT_NEAR(std::stod(f[1]), entry.at("noise").get<double>(), 1e-9);
+    EXPECT_EQ(std::stoll(f[2]), entry.at("paths_per_pixel").get<int64_t>() / 2);
+    EXPECT_EQ(f[4], "shipped");
+    EXPECT_NE(f[5].find("provenance.json"), std::string::npos);
+    const Image shipped = ReadImage((set / "ground-noon.exr").string());
+    const Image used =
+        ReadImage((dir / "out" / "images" / "ground-noon" / "reference.exr").string());
+    ASSERT_EQ(used.size(), shipped.size());
+    for (size_t i = 0; i < used.size(); ++i) ASSERT_EQ(used.data()[i], shipped.data()[i]) << i;
+    EXPECT_NE(Slurp(dir / "out" / "index.html").find("shipped: "), std::string::npos);
+}
+
+// A changed atmosphere, reference option, view or estimator version, and a
+// damaged set: compare renders instead and names the cause in one line.
+TEST(Cli, CompareRendersWhenTheShippedReferenceIsStale) {
+    const fs::path dir = TempDir("shipped-stale");
+    const fs::path set = MakeShippedSet(dir);
+    const std::string provenance = Slurp(set / "provenance.json");
+    auto run = [&](const std::string& extra) {
+        CliRun r = Atmos(
+            "compare --models empty --views ground-noon --size 16x9 "
+            "--reference-noise 0.2 --reference-spp 64 --no-cache "
+            "--shipped-references " +
+                set.string() + " -o " + (dir / "out").string() + " " + extra,
+            dir);
+        EXPECT_EQ(r.status, 0) << r.err;
+        EXPECT_NE(r.err.find("reference (reference) rendered"), std::string::npos) << r.err;
+        EXPECT_EQ(NoiseRows(dir / "out" / "reference_noise.csv").at("ground-noon").at(4),
+                  "rendered");
+        return r.err;
+    };
+    auto expect_line = [](const std::string& err, const std::string& line) {
+        EXPECT_NE(err.find(line + "\n"), std::string::npos) << err;
+    };
+    expect_line(run("--set rayleigh_scattering=6.38e-6,1.491e-5,3.641e-5"),
+                "ground-noon: shipped reference not used: atmosphere differs (shipped earth)");
+    EXPECT_NE(run("--reference reference:max-order=4")
+                  .find("ground-noon: shipped reference not used: reference model options differ"),
+              std::string::npos);
+    nlohmann::json edited = nlohmann::json::parse(provenance);
+    edited["views"][0]["view_hash"] = "fnv1a64:0000000000000000";
+    edited["fingerprint"]["estimator_version"] = 0;
+    std::ofstream(set / "provenance.json") << edited.dump(1);
+    const std::string both = run("");
+    EXPECT_NE(both.find("ground-noon: shipped reference not used: estimator version differs "
+                        "(shipped 0, this build "),
+              std::string::npos)
+        << both;
+    EXPECT_NE(both.find("); view differs\n"), std::string::npos) << both;
+    // Damaged: a warning, and the run goes on.
+    std::ofstream(set / "provenance.json") << provenance.substr(0, provenance.size() / 2);
+    const std::string bad = run("");
+    EXPECT_NE(bad.find("atmos: warning: shipped references not used: " +
+                       (set / "provenance.json").string() + ": invalid JSON"),
+              std::string::npos)
+        << bad;
+    std::ofstream(set / "provenance.json") << provenance;
+    Image variance = ReadImage((set / "ground-noon.variance.exr").string());
+    variance.data()[5] = std::nanf("");
+    WriteImage(variance, (set / "ground-noon.variance.exr").string());
+    expect_line(run(""), "ground-noon: shipped reference not used: " +
+                             (set / "ground-noon.variance.exr").string() +
+                             " holds a NaN, infinite or negative value");
+    fs::remove(set / "ground-noon.variance.exr");
+    expect_line(run(""), "ground-noon: shipped reference not used: " +
+                             (set / "ground-noon.variance.exr").string() + " is missing");
+    // Flags: a missing directory, both flags, transmittance.
+    const std::string base =
+        "compare --models empty --views ground-noon --size 16x9 -o " + (dir / "x").string() + " ";
+    CliRun missing = Atmos(base + "--shipped-references " + (dir / "nope").string(), dir);
+    EXPECT_EQ(missing.status, 2);
+    EXPECT_NE(missing.err.find("is not a directory"), std::string::npos) << missing.err;
+    EXPECT_EQ(Atmos(base + "--shipped-references " + set.string() + " --no-shipped-references", dir)
+                  .status,
+              2);
+    EXPECT_EQ(
+        Atmos(base + "--quantity transmittance --shipped-references " + set.string(), dir).status,
+        2);
+    // The recorder: a malformed entry is one error line.
+    CliRun entry = Atmos("reference-provenance --views ground-noon --size 16x9 --record " +
+                             (dir / "rec").string() +
+                             " --entry '{\"view\":\"ground-noon\",\"paths_per_pixel\":0,"
+                             "\"noise\":0.1}'",
+                         dir);
+    EXPECT_EQ(entry.status, 2);
+    EXPECT_EQ(entry.err,
+              "atmos: error: reference-provenance --record: the entry: paths_per_pixel must be "
+              "positive and noise in [0, 1)\n");
+}
+
+// By default compare looks in data/references/WxH of the source tree when the
+// reference renders to a noise target; a fixed --reference-spp uses shipped
+// references only when named; --no-shipped-references never.
+TEST(Cli, CompareLooksForShippedReferencesOfItsSize) {
+    const fs::path dir = TempDir("shipped-default");
+    const fs::path set = MakeShippedSet(dir);
+    const fs::path tree = dir / "tree";
+    fs::create_directories(tree / "data" / "references");
+    fs::copy(set, tree / "data" / "references" / "16x9");
+    fs::create_directory_symlink(fs::path(ATMOS_SOURCE_DIR) / "src", tree / "src");
+    ::setenv("ATMOS_SOURCE_DIR", tree.c_str(), 1);
+    auto source = [&](const std::string& extra) {
+        CliRun r = Atmos("compare --models empty --views ground-noon --size 16x9 --no-cache -o " +
+                             (dir / "out").string() + " " + extra,
+                         dir);
+        EXPECT_EQ(r.status, 0) << r.err;
+        return NoiseRows(dir / "out" / "reference_noise.csv").at("ground-noon").at(4);
+    };
+    EXPECT_EQ(source("--reference-noise 0.2"), "shipped");
+    EXPECT_EQ(source("--reference-noise 0.2 --no-shipped-references"), "rendered");
+    EXPECT_EQ(source("--reference-spp 4"), "rendered");
+    EXPECT_EQ(source("--reference-spp 4 --shipped-references " +
+                     (tree / "data" / "references" / "16x9").string()),
+              "shipped");
+    ::unsetenv("ATMOS_SOURCE_DIR");
 }
 
 }  // namespace

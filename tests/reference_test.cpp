@@ -1004,16 +1004,18 @@ TEST(ReferenceShipped, FreshRenderAgreesWithEachShippedImageWithinItsNoise) {
     std::ifstream in(dir / "provenance.json");
     ASSERT_TRUE(in.good()) << dir;
     const nlohmann::json provenance = nlohmann::json::parse(in);
-    const std::string size = provenance.at("size");
+    const nlohmann::json& fingerprint = provenance.at("fingerprint");
+    const std::string size = fingerprint.at("size");
     const int width = std::stoi(size.substr(0, size.find('x')));
     const int height = std::stoi(size.substr(size.find('x') + 1));
-    const AtmosphereParameters atm = LoadAtmosphere(provenance.at("atmosphere"));
+    const AtmosphereParameters atm = LoadAtmosphere(fingerprint.at("atmosphere"));
     const AtmosphereParameters changed = [&] {
         AtmosphereParameters c = atm;
         c.rayleigh_scattering = atm.rayleigh_scattering * 1.1;
         return c;
     }();
-    std::unique_ptr<Model> model = CreateModel(ParseModelSpec(provenance.at("model")));
+    // The model with the options it was rendered with (every one resolved).
+    std::unique_ptr<Model> model = CreateModel(ParseModelSpec(fingerprint.at("model")));
     for (const nlohmann::json& entry : provenance.at("views")) {
         const std::string name = entry.at("view");
         SCOPED_TRACE(name);

@@ -86,5 +86,6 @@ Command AddBenchCommand(CLI::App* root);
 Command AddLocCommand(CLI::App* root);
 Command AddFitCommand(CLI::App* root);
 Command AddValidateCommand(CLI::App* root);
+Command AddReferenceProvenanceCommand(CLI::App* root);
 
 }  // namespace atmos::cli

@@ -2,6 +2,7 @@
 // (src/atmos/harness/compare.h), tables + images + index.html.
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -15,6 +16,7 @@
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "harness/compare.h"
+#include "harness/loc.h"
 #include "harness/spectral_run.h"
 #include "io/output_path.h"
 #include "render/progressive.h"
@@ -57,6 +59,9 @@ struct CompareCliOptions {
     std::string command_line;
     SpectralFlags spectral;
     std::string reference_wavelengths;
+    std::string shipped;
+    CLI::Option* shipped_flag = nullptr;
+    bool no_shipped = false;
 };
 
 bool IsRegistered(const std::string& name) {
@@ -156,6 +161,36 @@ int CmdCompare(const CompareCliOptions& o) {
             config.reference_model, " is not one)");
     }
     CreateModel(config.reference_model, config.reference_options);  // validate the options
+    // Shipped references (harness/shipped_references.h): --shipped-references DIR,
+    // else data/references/WxH of the source tree when it exists and the
+    // reference renders to a noise target (a fixed --reference-spp asks for that
+    // estimate: shipped ones only when named); --no-shipped-references: never.
+    const bool shipped_applies = GetModelInfo(config.reference_model).capabilities.stochastic &&
+                                 config.quantity == Quantity::kRadiance &&
+                                 config.wavelengths.empty() && o.reference_wavelengths.empty();
+    if (o.shipped_flag->count() > 0) {
+        if (o.no_shipped) {
+            Fail("--shipped-references and --no-shipped-references exclude each other");
+        }
+        std::error_code ec;
+        if (!std::filesystem::is_directory(o.shipped, ec)) {
+            Fail("--shipped-references: '", o.shipped, "' is not a directory");
+        }
+        if (!shipped_applies) {
+            Fail(
+                "--shipped-references: shipped references stand for a Monte Carlo reference's "
+                "RGB radiance (not with --quantity transmittance, --wavelengths or "
+                "--reference-wavelengths)");
+        }
+        config.shipped_references = o.shipped;
+    } else if (!o.no_shipped && shipped_applies &&
+               config.reference_monte_carlo.noise_target > 0.0) {
+        const std::filesystem::path dir =
+            std::filesystem::path(DefaultSourceDir()) / "data" / "references" /
+            (std::to_string(config.width) + "x" + std::to_string(config.height));
+        std::error_code ec;
+        if (std::filesystem::is_directory(dir, ec)) config.shipped_references = dir.string();
+    }
     if (!config.reference_wavelengths.empty()) {
         config.reference_note += "; rendered spectrally at " +
                                  std::to_string(config.reference_wavelengths.size()) +
@@ -213,6 +248,15 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
     cmd->add_option("--reference", o->reference,
                     "reference model and its options, NAME[:OPTION=VALUE...] (default: "
                     "`reference` when registered, else naive:steps=256:light-steps=64)");
+    o->shipped_flag = cmd->add_option(
+        "--shipped-references", o->shipped,
+        "a directory of shipped references (scripts/make_references.sh): a view whose "
+        "provenance matches the run (atmosphere, view, reference options, size, estimator "
+        "version) and whose noise is at or below --reference-noise, or whose paths per pixel "
+        "reach --reference-spp, is read instead of rendered (default: data/references/WxH of "
+        "the source tree when it exists and the reference renders to a noise target)");
+    cmd->add_flag("--no-shipped-references", o->no_shipped,
+                  "render every view's reference: read no shipped references");
     cmd->add_option("--atmosphere,-a", o->atmosphere, "preset name or JSON file")
         ->capture_default_str();
     cmd->add_option("--set", o->sets, "override one atmosphere field: FIELD=VALUE (repeatable)")

@@ -21,12 +21,19 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     app.set_version_flag("--version", "atmos 0.1.0");
     const std::vector<Command> commands = {
-        AddListCommand(&app),   AddRenderCommand(&app),
-        AddSampleCommand(&app), AddBakeCommand(&app),
-        AddViewerCommand(&app), AddFlipCommand(&app),
-        AddRmseCommand(&app),   AddCompareCommand(&app, argc, argv),
-        AddBenchCommand(&app),  AddLocCommand(&app),
-        AddFitCommand(&app),    AddValidateCommand(&app),
+        AddListCommand(&app),
+        AddRenderCommand(&app),
+        AddSampleCommand(&app),
+        AddBakeCommand(&app),
+        AddViewerCommand(&app),
+        AddFlipCommand(&app),
+        AddRmseCommand(&app),
+        AddCompareCommand(&app, argc, argv),
+        AddBenchCommand(&app),
+        AddLocCommand(&app),
+        AddFitCommand(&app),
+        AddValidateCommand(&app),
+        AddReferenceProvenanceCommand(&app),
     };
     try {
         if (argc > 1 && argv[1][0] != '-') {

@@ -14,6 +14,7 @@
 #include "harness/ranking.h"
 #include "harness/render_cache.h"
 #include "harness/report.h"
+#include "harness/shipped_references.h"
 #include "harness/spectral_run.h"
 #include "io/output_path.h"
 #include "metrics/rmse.h"
@@ -378,6 +379,22 @@ CompareResult RunCompare(const CompareConfig& config) {
     LazyRenderer rgb_reference(config.reference_model, config.reference_options, config, cache,
                                whole);
     rgb_reference.SetViews(views);
+    // Shipped references (RGB radiance, a Monte Carlo reference): read once; a
+    // damaged set is a warning and every view renders.
+    std::unique_ptr<ShippedReferences> shipped;
+    ReferenceFingerprint run_fingerprint;
+    if (!config.shipped_references.empty() && !transmittance && config.wavelengths.empty() &&
+        !spectral_reference && reference_info.capabilities.stochastic) {
+        try {
+            run_fingerprint = MakeReferenceFingerprint(
+                config.reference_model, config.reference_options, config.atmosphere_name,
+                config.atmosphere, config.width, config.height, views);
+            shipped = std::make_unique<ShippedReferences>(
+                ReadShippedReferences(config.shipped_references));
+        } catch (const Error& e) {
+            std::fprintf(stderr, "atmos: warning: shipped references not used: %s\n", e.what());
+        }
+    }
 
     for (const View& view : views) {
         CompareRow row;
@@ -391,11 +408,42 @@ CompareResult RunCompare(const CompareConfig& config) {
         fs::create_directories(error_dir);
         MonteCarloReport ref_report;
         Image ref_variance;  // per-pixel variance of the reference's estimate (may stay empty)
-        Image ref = reference.Render(view, &row.reference_seconds, &row.reference_cached,
-                                     &ref_report, &ref_variance);
-        row.reference_spp = ref_report.samples;
-        if (noise_target) row.reference_noise = ref_report.noise;
-        if (split_reference) {
+        Image ref;
+        if (shipped) {
+            // The shipped image when it matches the run and is at least as good as
+            // the run's render would be (its noise at or below the target, or at
+            // least the run's paths per pixel).
+            std::string why = ShippedMismatch(*shipped, run_fingerprint, view.name,
+                                              noise_target ? mc.noise_target : 0.0, mc.spp);
+            if (why.empty()) {
+                try {
+                    LoadShippedImages(*shipped, view.name, config.width, config.height, &ref,
+                                      &ref_variance);
+                    const ShippedView& v = *shipped->Find(view.name);
+                    row.reference_source = "shipped";
+                    row.reference_spp = v.paths_per_pixel;
+                    row.reference_noise = v.noise;
+                    row.reference_provenance =
+                        (fs::path(shipped->directory) / "provenance.json").string() +
+                        (v.commit.empty() ? "" : " (commit " + v.commit.substr(0, 12) + ")");
+                } catch (const std::exception& e) {
+                    why = e.what();
+                    ref = Image();
+                    ref_variance = Image();
+                }
+            }
+            if (!why.empty()) {
+                std::fprintf(stderr, "%s: shipped reference not used: %s\n", view.name.c_str(),
+                             why.c_str());
+            }
+        }
+        if (row.reference_source != "shipped") {
+            ref = reference.Render(view, &row.reference_seconds, &row.reference_cached, &ref_report,
+                                   &ref_variance);
+            row.reference_spp = ref_report.samples;
+            if (noise_target) row.reference_noise = ref_report.noise;
+        }
+        if (split_reference && row.reference_source != "shipped") {
             double seconds_b = 0.0;
             bool cached_b = false;
             Image variance_b;
@@ -423,6 +471,7 @@ CompareResult RunCompare(const CompareConfig& config) {
             row.reference_spp = spp_a + spp_b;
             row.reference_cached = row.reference_cached && cached_b;
         }
+        if (row.reference_cached) row.reference_source = "cached";
         if (ref_variance.size() == ref.size() && ref.size() > 0) {
             double sum = 0.0;
             for (size_t i = 0; i < ref_variance.size(); ++i)
@@ -453,14 +502,19 @@ CompareResult RunCompare(const CompareConfig& config) {
         row.reference_png = (fs::path("images") / FileStem(view.name) / "reference.png").string();
         if (config.show_progress) {
             std::fprintf(stderr, "%-22s reference (%s) %s %.3f s", view.name.c_str(),
-                         config.reference_model.c_str(),
-                         row.reference_cached ? "cached" : "rendered", row.reference_seconds);
+                         config.reference_model.c_str(), row.reference_source.c_str(),
+                         row.reference_seconds);
+            if (!row.reference_provenance.empty()) {
+                std::fprintf(stderr, " from %s", row.reference_provenance.c_str());
+            }
             if (row.reference_noise >= 0.0) {
+                const bool above = noise_target && row.reference_noise > mc.noise_target;
                 std::fprintf(stderr, "  noise %.4f at %lld spp%s", row.reference_noise,
                              static_cast<long long>(row.reference_spp),
-                             noise_target && row.reference_noise > mc.noise_target
-                                 ? " (cap reached, above the target)"
-                                 : "");
+                             !above ? ""
+                             : row.reference_source == "shipped"
+                                 ? " (above the target, at the cap or more)"
+                                 : " (cap reached, above the target)");
             }
             std::fprintf(stderr, "\n");
         }
@@ -545,12 +599,16 @@ CompareResult RunCompare(const CompareConfig& config) {
                    flip_noise);
     WriteMetricCsv((out / "rmse.csv").string(), "RMSE errors", labels, result.models, rmses,
                    rmse_noise);
-    if (split_reference || noise_target) {
+    if (split_reference || noise_target || shipped) {
+        // source: rendered, cached or shipped (then provenance: its provenance.json).
         TextOutput f((out / "reference_noise.csv").string());
-        f << "view,reference_noise_flip,half_spp,noise_target\n";
+        f << "view,reference_noise_flip,half_spp,noise_target,source,provenance\n";
         for (const CompareRow& row : result.rows) {
+            std::string provenance = row.reference_provenance;
+            for (char& c : provenance) c = c == ',' ? ';' : c;
             f << row.view << "," << row.reference_noise << "," << row.reference_spp / 2 << ","
-              << (noise_target ? mc.noise_target : 0.0) << "\n";
+              << (noise_target ? mc.noise_target : 0.0) << "," << row.reference_source << ","
+              << provenance << "\n";
         }
         f.Commit();
     }

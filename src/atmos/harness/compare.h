@@ -40,6 +40,12 @@ struct CompareConfig {
     // (spp: the cap).
     MonteCarloSettings reference_monte_carlo;
     std::string reference_note;  // how the reference was chosen (shown in the report)
+    // A directory of shipped references (harness/shipped_references.h; ""
+    // none): a view whose shipped image matches the run (fingerprint, view, an
+    // estimate at least as good as the run's) is read instead of rendered; any
+    // other view is rendered and the reason printed. RGB radiance with a Monte
+    // Carlo reference only. A damaged set is a warning: every view renders.
+    std::string shipped_references;
     std::string atmosphere_name = "earth";
     AtmosphereParameters atmosphere;
     // Spectral comparison (--wavelengths; harness/spectral_run.h): every model and
@@ -87,6 +93,11 @@ struct CompareRow {
     std::string reference_png;
     double reference_seconds = 0.0;
     bool reference_cached = false;
+    // Where the reference came from: "rendered", "cached" or "shipped"
+    // (CompareConfig::shipped_references; then reference_provenance names the
+    // provenance file and the commit that rendered it).
+    std::string reference_source = "rendered";
+    std::string reference_provenance;
     // --reference-wavelengths: the RGB reference's render time (else 0).
     double rgb_reference_seconds = 0.0;
     // A Monte Carlo reference is rendered as two independent halves (spp/2

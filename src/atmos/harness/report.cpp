@@ -173,7 +173,13 @@ void TimeChart(std::ostream& f, const CompareConfig& config, const CompareResult
     f << "<p>Reference (" << HtmlEscape(config.reference_model)
       << "), apart from the chart: " << Duration(ref) << " per view"
       << (ref_cached ? " (cached: the original render's time)" : "");
-    if (hi > 0.0) f << ", " << General(ref / hi, 3) << "&times; the slowest model";
+    size_t shipped = 0;
+    for (const CompareRow& row : r.rows) shipped += row.reference_source == "shipped" ? 1 : 0;
+    if (shipped > 0) {
+        f << " (" << shipped << " of " << r.rows.size()
+          << " views shipped, not rendered: counted as 0 s)";
+    }
+    if (hi > 0.0 && ref > 0.0) f << ", " << General(ref / hi, 3) << "&times; the slowest model";
     f << ".</p>\n";
 }
 
@@ -586,6 +592,16 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
              "this reference: lower <code>--reference-noise</code> (or raise the cap) to rank "
              "those models.";
     }
+    std::string shipped_views;
+    for (const CompareRow& row : r.rows) {
+        if (row.reference_source == "shipped")
+            shipped_views += (shipped_views.empty() ? "" : ", ") + row.label;
+    }
+    if (!shipped_views.empty()) {
+        f << " Shipped references (not rendered in this run; their provenance, paths per pixel and "
+             "noise under each view's reference image): "
+          << HtmlEscape(shipped_views) << ".";
+    }
     f << "</p>\n";
     MetricTable(f,
                 transmittance ? "FLIP errors, transmittance (LDR-FLIP)" : "FLIP errors (HDR-FLIP)",
@@ -630,7 +646,12 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
         f << "<div class=\"row\">\n<figure><img src=\"" << HtmlEscape(row.reference_png)
           << "\" alt=\"reference\" title=\"reference, " << HtmlEscape(row.label)
           << "\"><figcaption><b>reference</b> (" << HtmlEscape(config.reference_model) << ")<br>"
-          << Fixed(row.reference_seconds, 3) + " s" << (row.reference_cached ? " (cached)" : "")
+          << (row.reference_source == "shipped"
+                  ? "shipped: " + HtmlEscape(row.reference_provenance) + "<br>" +
+                        std::to_string(row.reference_spp) + " paths per pixel, noise " +
+                        Fixed(row.reference_noise, 4)
+                  : Fixed(row.reference_seconds, 3) + " s" +
+                        (row.reference_cached ? " (cached)" : ""))
           << "</figcaption></figure>\n";
         for (size_t m = 0; m < row.cells.size(); ++m) {
             const CompareCell& c = row.cells[m];

@@ -74,6 +74,15 @@
 
 namespace atmos {
 
+// The version of what `reference` estimates, recorded in the fingerprint of
+// shipped references (harness/shipped_references.h; data/references/). Bump it
+// with any change that could move the expected value of an image: the
+// physics (phase functions, densities, ground, sun), a table's resolution or
+// quadrature (the sun column table, the order-1 table), a new bias or its
+// removal. A change of variance only (sampling, majorants, MIS) keeps it; an
+// option's default change is caught by the fingerprint's resolved options.
+inline constexpr int kReferenceEstimatorVersion = 1;
+
 constexpr int kMaxReferenceShells = 64;
 
 // Shells of the piecewise-constant majorant: shell i spans radii
