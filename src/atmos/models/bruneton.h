@@ -386,7 +386,8 @@ struct BrunetonLut {
     ATMOS_HD void RMuMuSNuFromScatteringUvwz(const double uvwz[4], double* r, double* mu,
                                              double* mu_s, double* nu,
                                              bool* ray_r_mu_intersects_ground) const {
-        const double H = HorizonH();
+        ATMOS_DASSERT(k.H > 0.0);
+        const double H = k.H;  // HorizonH()
         const double rho = H * GetUnitRangeFromTextureCoord(uvwz[3], cfg.scattering_r);
         *r = Sqrt(rho * rho + atm.bottom_radius * atm.bottom_radius);
         const int half = cfg.scattering_mu / 2;
@@ -406,13 +407,12 @@ struct BrunetonLut {
             *ray_r_mu_intersects_ground = false;
         }
         const double x_mu_s = GetUnitRangeFromTextureCoord(uvwz[1], cfg.scattering_mu_s);
-        const double d_min = atm.top_radius - atm.bottom_radius;
-        const double d_max = H;
-        const double D =
-            DistanceToTopAtmosphereBoundary(atm.bottom_radius, atm.mu_s_min, atm.top_radius);
-        const double A = (D - d_min) / (d_max - d_min);
+        // The seed's d_min = top - bottom, d_max = H and A from k (the same
+        // operations, done once in the constructor).
+        const double d_min = k.mu_s_d_min;
+        const double A = k.mu_s_big_a;
         const double a = (A - x_mu_s * A) / (1.0 + x_mu_s * A);
-        const double d = d_min + Min(a, A) * (d_max - d_min);
+        const double d = d_min + Min(a, A) * k.mu_s_d_range;
         *mu_s = d == 0.0 ? 1.0 : ClampCosine((H * H - d * d) / (2.0 * atm.bottom_radius * d));
         *nu = ClampCosine(uvwz[0] * 2.0 - 1.0);
     }
@@ -443,12 +443,28 @@ struct BrunetonLut {
         return table.SampleTrilinear(u0, uvwz[2], uvwz[3]) * (1.0f - lerp) +
                table.SampleTrilinear(u1, uvwz[2], uvwz[3]) * lerp;
     }
+    // A 3-channel table (the precomputation's delta tables) through the
+    // fixed-layout lookup (BrunetonSample4D, bit-identical to Lookup4D).
     ATMOS_HD Vec4f GetScattering(const TableView& table, double r, double mu, double mu_s,
                                  double nu, bool ray_r_mu_intersects_ground) const {
         double uvwz[4];
         ScatteringUvwz(ClampRadius(r), ClampCosine(mu), ClampCosine(mu_s), ClampCosine(nu),
                        ray_r_mu_intersects_ground, uvwz);
-        return Lookup4D(table, cfg.scattering_nu, uvwz);
+        if (table.channels != 3) return Lookup4D(table, cfg.scattering_nu, uvwz);
+        const Bruneton4DRows rows =
+            BrunetonSplitRows(table.width, table.height, table.depth, uvwz[2], uvwz[3]);
+        const double tex_coord_x = uvwz[0] * (cfg.scattering_nu - 1);
+        const double tex_x = floor(tex_coord_x);
+        const Bruneton4DColumns cols =
+            BrunetonSplitColumns(table.width, cfg.scattering_nu, tex_x,
+                                 static_cast<float>(tex_coord_x - tex_x), uvwz[1]);
+        float o[3];
+        BrunetonSample4D<3>(table.data, rows, cols, o);
+        Vec4f v;
+        v.x = o[0];
+        v.y = o[1];
+        v.z = o[2];
+        return v;
     }
 
     // Seed 004 GetExtrapolatedSingleMieScattering (combined storage).
