@@ -428,8 +428,19 @@ struct BrunetonLut {
             (mu_s_index + 0.5) / cfg.scattering_mu_s, (y + 0.5) / cfg.scattering_mu,
             (z + 0.5) / cfg.scattering_r};
         RMuMuSNuFromScatteringUvwz(uvwz, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
-        const double s = SafeSqrt((1.0 - *mu * *mu) * (1.0 - *mu_s * *mu_s));
-        *nu = Clamp(*nu, *mu * *mu_s - s, *mu * *mu_s + s);
+        *nu = ClampNu(*nu, *mu, *mu_s);
+    }
+    // Its parts for a row of texels (mu_s depends on x % MU_S only, nu before
+    // its clamp on x / MU_S only): nu of texel column nu_index before the clamp,
+    // and the clamp to the range that mu and mu_s allow.
+    ATMOS_HD double TexelNuUnclamped(int nu_index) const {
+        const double u =
+            cfg.scattering_nu > 1 ? static_cast<double>(nu_index) / (cfg.scattering_nu - 1) : 0.5;
+        return ClampCosine(u * 2.0 - 1.0);
+    }
+    ATMOS_HD static double ClampNu(double nu, double mu, double mu_s) {
+        const double s = SafeSqrt((1.0 - mu * mu) * (1.0 - mu_s * mu_s));
+        return Clamp(nu, mu * mu_s - s, mu * mu_s + s);
     }
 
     // 4D lookup as two 3D lookups (seed 004 GetScattering), from the mapped

@@ -185,12 +185,18 @@ void ComputeBrunetonMultipleScatteringRowsScalar(const BrunetonLut& lut, const T
 
 namespace {
 
-// The row's (mu_s, nu) per texel, x = nu * MU_S + mu_s (RMuMuSNuFromTexel).
+// The row's (mu_s, nu) per texel, x = nu * MU_S + mu_s: RMuMuSNuFromTexel's
+// values, its mapping done once per mu_s column.
 void RowMuSNu(const BrunetonLut& lut, int y, int z, int width, double* mu_s_x, double* nu_x) {
+    const int mu_s_size = lut.cfg.scattering_mu_s;
+    double r, mu = 0.0, nu;
+    bool ground;
+    for (int x = 0; x < mu_s_size; ++x) {
+        lut.RMuMuSNuFromTexel(x, y, z, &r, &mu, &mu_s_x[x], &nu, &ground);
+    }
+    for (int x = mu_s_size; x < width; ++x) mu_s_x[x] = mu_s_x[x % mu_s_size];
     for (int x = 0; x < width; ++x) {
-        double r, mu;
-        bool ground;
-        lut.RMuMuSNuFromTexel(x, y, z, &r, &mu, &mu_s_x[x], &nu_x[x], &ground);
+        nu_x[x] = BrunetonLut::ClampNu(lut.TexelNuUnclamped(x / mu_s_size), mu, mu_s_x[x]);
     }
 }
 
