@@ -454,6 +454,16 @@ struct BrunetonLut {
         return table.SampleTrilinear(u0, uvwz[2], uvwz[3]) * (1.0f - lerp) +
                table.SampleTrilinear(u1, uvwz[2], uvwz[3]) * lerp;
     }
+    // The texels and weights of the 4D lookup of table t (the scattering
+    // layout) at uvwz: computed once, shared by the tables of that layout.
+    ATMOS_HD void Split4D(const TableView& t, const double uvwz[4], Bruneton4DRows* rows,
+                          Bruneton4DColumns* cols) const {
+        *rows = BrunetonSplitRows(t.width, t.height, t.depth, uvwz[2], uvwz[3]);
+        const double tex_coord_x = uvwz[0] * (cfg.scattering_nu - 1);
+        const double tex_x = floor(tex_coord_x);
+        *cols = BrunetonSplitColumns(t.width, cfg.scattering_nu, tex_x,
+                                     static_cast<float>(tex_coord_x - tex_x), uvwz[1]);
+    }
     // A 3-channel table (the precomputation's delta tables) through the
     // fixed-layout lookup (BrunetonSample4D, bit-identical to Lookup4D).
     ATMOS_HD Vec4f GetScattering(const TableView& table, double r, double mu, double mu_s,
@@ -462,13 +472,9 @@ struct BrunetonLut {
         ScatteringUvwz(ClampRadius(r), ClampCosine(mu), ClampCosine(mu_s), ClampCosine(nu),
                        ray_r_mu_intersects_ground, uvwz);
         if (table.channels != 3) return Lookup4D(table, cfg.scattering_nu, uvwz);
-        const Bruneton4DRows rows =
-            BrunetonSplitRows(table.width, table.height, table.depth, uvwz[2], uvwz[3]);
-        const double tex_coord_x = uvwz[0] * (cfg.scattering_nu - 1);
-        const double tex_x = floor(tex_coord_x);
-        const Bruneton4DColumns cols =
-            BrunetonSplitColumns(table.width, cfg.scattering_nu, tex_x,
-                                 static_cast<float>(tex_coord_x - tex_x), uvwz[1]);
+        Bruneton4DRows rows;
+        Bruneton4DColumns cols;
+        Split4D(table, uvwz, &rows, &cols);
         float o[3];
         BrunetonSample4D<3>(table.data, rows, cols, o);
         Vec4f v;
@@ -494,11 +500,9 @@ struct BrunetonLut {
         ScatteringUvwz(ClampRadius(r), ClampCosine(mu), ClampCosine(mu_s), ClampCosine(nu),
                        ray_r_mu_intersects_ground, uvwz);
         const TableView& t = scattering_table;
-        const Bruneton4DRows rows = BrunetonSplitRows(t.width, t.height, t.depth, uvwz[2], uvwz[3]);
-        const double tex_coord_x = uvwz[0] * (cfg.scattering_nu - 1);
-        const double tex_x = floor(tex_coord_x);
-        const Bruneton4DColumns cols = BrunetonSplitColumns(
-            t.width, cfg.scattering_nu, tex_x, static_cast<float>(tex_coord_x - tex_x), uvwz[1]);
+        Bruneton4DRows rows;
+        Bruneton4DColumns cols;
+        Split4D(t, uvwz, &rows, &cols);
         if (cfg.combined_mie) {
             float c[4];
             BrunetonSample4D<4>(t.data, rows, cols, c);

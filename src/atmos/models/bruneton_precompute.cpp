@@ -39,6 +39,57 @@ int64_t TexelCount(const Table& t) {
     return static_cast<int64_t>(t.width()) * t.height() * t.depth();
 }
 
+// One (r, mu) row of the scattering table: its texel row (y, z), the view ray
+// (r, mu; whether it hits the ground), the interval dx, and the samples along
+// it that the row's texels share, sample i made by make(r, mu, ground, dx, i,
+// n, thick) (thick: the node's ThickRayWeights factor on a ray with optically
+// thick steps, else nullptr).
+template <typename Sample>
+struct RowSamples {
+    int y = 0, z = 0;
+    double r = 0.0, mu = 0.0, dx = 0.0;
+    bool ground = false;
+    std::vector<Sample> samples;
+};
+template <typename Sample, typename Make>
+RowSamples<Sample> MakeRowSamples(const BrunetonLut& lut, int64_t row, const Make& make) {
+    const BrunetonConfig& c = lut.cfg;
+    RowSamples<Sample> s;
+    s.y = static_cast<int>(row % c.scattering_mu);
+    s.z = static_cast<int>(row / c.scattering_mu);
+    double mu_s, nu;
+    lut.RMuMuSNuFromTexel(0, s.y, s.z, &s.r, &s.mu, &mu_s, &nu, &s.ground);
+    const int n = c.scattering_samples;
+    s.dx = lut.DistanceToNearestAtmosphereBoundary(s.r, s.mu, s.ground) / n;
+    s.samples.resize(static_cast<size_t>(n) + 1);
+    const bool thick = RayHasThickSteps(lut.atm, s.r, s.mu, s.dx, n);
+    ThickRayWeights weights(s.r, s.mu, s.dx, n);
+    for (int i = 0; i <= n; ++i) {
+        Vec3d w;
+        if (thick) w = weights.Next(lut.atm, i);
+        s.samples[static_cast<size_t>(i)] =
+            make(s.r, s.mu, s.ground, s.dx, i, n, thick ? &w : nullptr);
+    }
+    return s;
+}
+RowSamples<BrunetonSingleSample> SingleScatteringRow(const BrunetonLut& lut, int64_t row) {
+    return MakeRowSamples<BrunetonSingleSample>(
+        lut, row,
+        [&lut](double r, double mu, bool ground, double dx, int i, int n, const Vec3d* thick) {
+            return BrunetonSingleScatteringSample(lut, r, mu, ground, dx, i, n, thick);
+        });
+}
+RowSamples<BrunetonMultipleSample> MultipleScatteringRow(const BrunetonLut& lut,
+                                                         const BrunetonFastLookup& fast,
+                                                         int64_t row) {
+    return MakeRowSamples<BrunetonMultipleSample>(
+        lut, row,
+        [&lut, &fast](double r, double mu, bool ground, double dx, int i, int n,
+                      const Vec3d* thick) {
+            return BrunetonMultipleScatteringSample(lut, fast, r, mu, ground, dx, i, n, thick);
+        });
+}
+
 }  // namespace
 
 void ValidateBrunetonConfig(const BrunetonConfig& c) {
@@ -85,22 +136,12 @@ void ComputeBrunetonSingleScatteringRowsScalar(const BrunetonLut& lut, Table* ra
     mie->Resize(width, c.scattering_mu, c.scattering_r, 3);
     const Clock::time_point start = Clock::now();
     ParallelFor(RowCount(c), 1, [&](int64_t row) {
-        const int y = static_cast<int>(row % c.scattering_mu);
-        const int z = static_cast<int>(row / c.scattering_mu);
-        double r, mu, mu_s, nu;
+        const RowSamples<BrunetonSingleSample> rs = SingleScatteringRow(lut, row);
+        const int y = rs.y, z = rs.z;
+        const double r = rs.r, dx = rs.dx;
+        const std::vector<BrunetonSingleSample>& samples = rs.samples;
+        double mu_s, nu;
         bool ground;
-        lut.RMuMuSNuFromTexel(0, y, z, &r, &mu, &mu_s, &nu, &ground);
-        const int n = c.scattering_samples;
-        const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
-        std::vector<BrunetonSingleSample> samples(static_cast<size_t>(n) + 1);
-        const bool thick = RayHasThickSteps(lut.atm, r, mu, dx, n);
-        ThickRayWeights weights(r, mu, dx, n);
-        for (int i = 0; i <= n; ++i) {
-            Vec3d w;
-            if (thick) w = weights.Next(lut.atm, i);
-            samples[static_cast<size_t>(i)] =
-                BrunetonSingleScatteringSample(lut, r, mu, ground, dx, i, n, thick ? &w : nullptr);
-        }
         const Rgb beta_r = Rgb(lut.atm.rayleigh_scattering * dx);
         const Rgb beta_m = Rgb(lut.atm.mie_scattering * dx);
         for (int x = 0; x < width; ++x) {
@@ -128,22 +169,12 @@ void ComputeBrunetonMultipleScatteringRowsScalar(const BrunetonLut& lut, const T
     const BrunetonFastLookup fast(lut, density);
     const Clock::time_point start = Clock::now();
     ParallelFor(RowCount(c), 1, [&](int64_t row) {
-        const int y = static_cast<int>(row % c.scattering_mu);
-        const int z = static_cast<int>(row / c.scattering_mu);
-        double r, mu, mu_s, nu;
+        const RowSamples<BrunetonMultipleSample> rs = MultipleScatteringRow(lut, fast, row);
+        const int y = rs.y, z = rs.z;
+        const double r = rs.r;
+        const std::vector<BrunetonMultipleSample>& samples = rs.samples;
+        double mu_s, nu;
         bool ground;
-        lut.RMuMuSNuFromTexel(0, y, z, &r, &mu, &mu_s, &nu, &ground);
-        const int n = c.scattering_samples;
-        const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
-        std::vector<BrunetonMultipleSample> samples(static_cast<size_t>(n) + 1);
-        const bool thick = RayHasThickSteps(lut.atm, r, mu, dx, n);
-        ThickRayWeights weights(r, mu, dx, n);
-        for (int i = 0; i <= n; ++i) {
-            Vec3d w;
-            if (thick) w = weights.Next(lut.atm, i);
-            samples[static_cast<size_t>(i)] = BrunetonMultipleScatteringSample(
-                lut, fast, r, mu, ground, dx, i, n, thick ? &w : nullptr);
-        }
         // Samples outer, texels inner: the four table rows of one sample stay in
         // the cache while the row's texels read them.
         const size_t w = static_cast<size_t>(width);
@@ -233,22 +264,10 @@ void ComputeBrunetonSingleScatteringRows(const BrunetonLut& lut, Table* rayleigh
     const double top2 = kc.top * kc.top;
     const Clock::time_point start = Clock::now();
     ParallelFor(RowCount(c), 1, [&](int64_t row) {
-        const int y = static_cast<int>(row % c.scattering_mu);
-        const int z = static_cast<int>(row / c.scattering_mu);
-        double r, mu, mu_s, nu;
-        bool ground;
-        lut.RMuMuSNuFromTexel(0, y, z, &r, &mu, &mu_s, &nu, &ground);
-        const int n = c.scattering_samples;
-        const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
-        std::vector<BrunetonSingleSample> samples(static_cast<size_t>(n) + 1);
-        const bool thick = RayHasThickSteps(atm, r, mu, dx, n);
-        ThickRayWeights weights(r, mu, dx, n);
-        for (int i = 0; i <= n; ++i) {
-            Vec3d w;
-            if (thick) w = weights.Next(atm, i);
-            samples[static_cast<size_t>(i)] =
-                BrunetonSingleScatteringSample(lut, r, mu, ground, dx, i, n, thick ? &w : nullptr);
-        }
+        const RowSamples<BrunetonSingleSample> rs = SingleScatteringRow(lut, row);
+        const int y = rs.y, z = rs.z;
+        const double r = rs.r, dx = rs.dx;
+        const std::vector<BrunetonSingleSample>& samples = rs.samples;
         const size_t wz = static_cast<size_t>(width);
         std::vector<double> texel(2 * wz);
         double* const mu_s_x = texel.data();
@@ -345,22 +364,10 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
     const double inv_nu = 1.0 / nu_size;
     const Clock::time_point start = Clock::now();
     ParallelFor(RowCount(c), 1, [&](int64_t row) {
-        const int y = static_cast<int>(row % c.scattering_mu);
-        const int z = static_cast<int>(row / c.scattering_mu);
-        double r, mu, mu_s, nu;
-        bool ground;
-        lut.RMuMuSNuFromTexel(0, y, z, &r, &mu, &mu_s, &nu, &ground);
-        const int n = c.scattering_samples;
-        const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
-        std::vector<BrunetonMultipleSample> samples(static_cast<size_t>(n) + 1);
-        const bool thick = RayHasThickSteps(lut.atm, r, mu, dx, n);
-        ThickRayWeights weights(r, mu, dx, n);
-        for (int i = 0; i <= n; ++i) {
-            Vec3d w;
-            if (thick) w = weights.Next(lut.atm, i);
-            samples[static_cast<size_t>(i)] = BrunetonMultipleScatteringSample(
-                lut, fast, r, mu, ground, dx, i, n, thick ? &w : nullptr);
-        }
+        const RowSamples<BrunetonMultipleSample> rs = MultipleScatteringRow(lut, fast, row);
+        const int y = rs.y, z = rs.z;
+        const double r = rs.r;
+        const std::vector<BrunetonMultipleSample>& samples = rs.samples;
         const size_t wz = static_cast<size_t>(width);
         std::vector<double> texel(3 * wz);
         double* const mu_s_x = texel.data();
