@@ -386,7 +386,8 @@ struct BrunetonLut {
     ATMOS_HD void RMuMuSNuFromScatteringUvwz(const double uvwz[4], double* r, double* mu,
                                              double* mu_s, double* nu,
                                              bool* ray_r_mu_intersects_ground) const {
-        const double H = HorizonH();
+        ATMOS_DASSERT(k.H > 0.0);
+        const double H = k.H;  // HorizonH()
         const double rho = H * GetUnitRangeFromTextureCoord(uvwz[3], cfg.scattering_r);
         *r = Sqrt(rho * rho + atm.bottom_radius * atm.bottom_radius);
         const int half = cfg.scattering_mu / 2;
@@ -406,13 +407,12 @@ struct BrunetonLut {
             *ray_r_mu_intersects_ground = false;
         }
         const double x_mu_s = GetUnitRangeFromTextureCoord(uvwz[1], cfg.scattering_mu_s);
-        const double d_min = atm.top_radius - atm.bottom_radius;
-        const double d_max = H;
-        const double D =
-            DistanceToTopAtmosphereBoundary(atm.bottom_radius, atm.mu_s_min, atm.top_radius);
-        const double A = (D - d_min) / (d_max - d_min);
+        // The seed's d_min = top - bottom, d_max = H and A from k (the same
+        // operations, done once in the constructor).
+        const double d_min = k.mu_s_d_min;
+        const double A = k.mu_s_big_a;
         const double a = (A - x_mu_s * A) / (1.0 + x_mu_s * A);
-        const double d = d_min + Min(a, A) * (d_max - d_min);
+        const double d = d_min + Min(a, A) * k.mu_s_d_range;
         *mu_s = d == 0.0 ? 1.0 : ClampCosine((H * H - d * d) / (2.0 * atm.bottom_radius * d));
         *nu = ClampCosine(uvwz[0] * 2.0 - 1.0);
     }
@@ -428,8 +428,19 @@ struct BrunetonLut {
             (mu_s_index + 0.5) / cfg.scattering_mu_s, (y + 0.5) / cfg.scattering_mu,
             (z + 0.5) / cfg.scattering_r};
         RMuMuSNuFromScatteringUvwz(uvwz, r, mu, mu_s, nu, ray_r_mu_intersects_ground);
-        const double s = SafeSqrt((1.0 - *mu * *mu) * (1.0 - *mu_s * *mu_s));
-        *nu = Clamp(*nu, *mu * *mu_s - s, *mu * *mu_s + s);
+        *nu = ClampNu(*nu, *mu, *mu_s);
+    }
+    // Its parts for a row of texels (mu_s depends on x % MU_S only, nu before
+    // its clamp on x / MU_S only): nu of texel column nu_index before the clamp,
+    // and the clamp to the range that mu and mu_s allow.
+    ATMOS_HD double TexelNuUnclamped(int nu_index) const {
+        const double u =
+            cfg.scattering_nu > 1 ? static_cast<double>(nu_index) / (cfg.scattering_nu - 1) : 0.5;
+        return ClampCosine(u * 2.0 - 1.0);
+    }
+    ATMOS_HD static double ClampNu(double nu, double mu, double mu_s) {
+        const double s = SafeSqrt((1.0 - mu * mu) * (1.0 - mu_s * mu_s));
+        return Clamp(nu, mu * mu_s - s, mu * mu_s + s);
     }
 
     // 4D lookup as two 3D lookups (seed 004 GetScattering), from the mapped
@@ -443,12 +454,34 @@ struct BrunetonLut {
         return table.SampleTrilinear(u0, uvwz[2], uvwz[3]) * (1.0f - lerp) +
                table.SampleTrilinear(u1, uvwz[2], uvwz[3]) * lerp;
     }
+    // The texels and weights of the 4D lookup of table t (the scattering
+    // layout) at uvwz: computed once, shared by the tables of that layout.
+    ATMOS_HD void Split4D(const TableView& t, const double uvwz[4], Bruneton4DRows* rows,
+                          Bruneton4DColumns* cols) const {
+        *rows = BrunetonSplitRows(t.width, t.height, t.depth, uvwz[2], uvwz[3]);
+        const double tex_coord_x = uvwz[0] * (cfg.scattering_nu - 1);
+        const double tex_x = floor(tex_coord_x);
+        *cols = BrunetonSplitColumns(t.width, cfg.scattering_nu, tex_x,
+                                     static_cast<float>(tex_coord_x - tex_x), uvwz[1]);
+    }
+    // A 3-channel table (the precomputation's delta tables) through the
+    // fixed-layout lookup (BrunetonSample4D, bit-identical to Lookup4D).
     ATMOS_HD Vec4f GetScattering(const TableView& table, double r, double mu, double mu_s,
                                  double nu, bool ray_r_mu_intersects_ground) const {
         double uvwz[4];
         ScatteringUvwz(ClampRadius(r), ClampCosine(mu), ClampCosine(mu_s), ClampCosine(nu),
                        ray_r_mu_intersects_ground, uvwz);
-        return Lookup4D(table, cfg.scattering_nu, uvwz);
+        if (table.channels != 3) return Lookup4D(table, cfg.scattering_nu, uvwz);
+        Bruneton4DRows rows;
+        Bruneton4DColumns cols;
+        Split4D(table, uvwz, &rows, &cols);
+        float o[3];
+        BrunetonSample4D<3>(table.data, rows, cols, o);
+        Vec4f v;
+        v.x = o[0];
+        v.y = o[1];
+        v.z = o[2];
+        return v;
     }
 
     // Seed 004 GetExtrapolatedSingleMieScattering (combined storage).
@@ -467,11 +500,9 @@ struct BrunetonLut {
         ScatteringUvwz(ClampRadius(r), ClampCosine(mu), ClampCosine(mu_s), ClampCosine(nu),
                        ray_r_mu_intersects_ground, uvwz);
         const TableView& t = scattering_table;
-        const Bruneton4DRows rows = BrunetonSplitRows(t.width, t.height, t.depth, uvwz[2], uvwz[3]);
-        const double tex_coord_x = uvwz[0] * (cfg.scattering_nu - 1);
-        const double tex_x = floor(tex_coord_x);
-        const Bruneton4DColumns cols = BrunetonSplitColumns(
-            t.width, cfg.scattering_nu, tex_x, static_cast<float>(tex_coord_x - tex_x), uvwz[1]);
+        Bruneton4DRows rows;
+        Bruneton4DColumns cols;
+        Split4D(t, uvwz, &rows, &cols);
         if (cfg.combined_mie) {
             float c[4];
             BrunetonSample4D<4>(t.data, rows, cols, c);

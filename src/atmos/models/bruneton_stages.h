@@ -596,18 +596,28 @@ Table MakeBrunetonDirectionTable();
 
 // The CPU's row forms of the single and multiple scattering stages: one (r, mu)
 // row at a time, the samples' row-shared parts computed once per row (same
-// helpers, same order of operations as the stages). Tables are resized.
+// helpers as the stages). Tables are resized. The CPU backend runs the
+// vectorised rows (a loop over the row's texels per view-ray sample on plain
+// arrays, `#pragma omp simd`): single scattering bit-identical to the scalar
+// rows, multiple scattering interpolating the density along (mu, r) once per
+// sample before x (float rounding apart). The scalar rows (per texel the
+// stages' helpers in their order) stay for the tests.
 void ComputeBrunetonSingleScatteringRows(const BrunetonLut& lut, Table* rayleigh, Table* mie);
 void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableView& density,
                                            Table* out);
+void ComputeBrunetonSingleScatteringRowsScalar(const BrunetonLut& lut, Table* rayleigh, Table* mie);
+void ComputeBrunetonMultipleScatteringRowsScalar(const BrunetonLut& lut, const TableView& density,
+                                                 Table* out);
 
 // PrecomputeBruneton with the choice of per-texel stages made explicit:
 // `texel_stages` runs every stage through its stage struct (what the CUDA
 // backend does, and does on the CPU backend too); otherwise the CPU's row forms
 // replace the single and multiple scattering stages. PrecomputeBruneton passes
-// texel_stages = (CurrentBackend() == Backend::kCuda).
+// texel_stages = (CurrentBackend() == Backend::kCuda). `scalar_rows`: the
+// CPU's scalar rows instead of the vectorised ones (tests, benchmarks).
 void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
                             bool texel_stages, BrunetonTables* tables,
-                            const BrunetonOrderCallback& on_order = nullptr);
+                            const BrunetonOrderCallback& on_order = nullptr,
+                            bool scalar_rows = false);
 
 }  // namespace atmos
