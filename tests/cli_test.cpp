@@ -650,7 +650,7 @@ TEST(Cli, SampleWavelengthsAddsSpectralColumns) {
         EXPECT_NEAR(array.values[i], v[i + 4], 1e-6 * std::abs(v[i + 4])) << i;
     }
     ExpectError("sample -m naive --wavelengths 700:400:3", "--wavelengths", in);
-    ExpectError("sample -m preetham --wavelengths 400:700:4", "per-wavelength", in);
+    ExpectError("sample -m neural --wavelengths 400:700:4", "per-wavelength", in);
     ExpectError("render -m naive --wavelengths 400:700:x -o " + (TempDir() / "s.exr").string(),
                 "--wavelengths");
 }
@@ -804,7 +804,7 @@ TEST(Cli, CompareWavelengths) {
     const std::string flip = Slurp(out / "flip.csv");
     EXPECT_NE(flip.find("ground-noon,"), std::string::npos) << flip;
     ExpectError(
-        "compare -q --no-cache --models preetham --reference naive --wavelengths 400:700:4 "
+        "compare -q --no-cache --models neural --reference naive --wavelengths 400:700:4 "
         "-o " +
             out.string(),
         "per-wavelength");
