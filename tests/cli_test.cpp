@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
@@ -650,7 +651,7 @@ TEST(Cli, SampleWavelengthsAddsSpectralColumns) {
         EXPECT_NEAR(array.values[i], v[i + 4], 1e-6 * std::abs(v[i + 4])) << i;
     }
     ExpectError("sample -m naive --wavelengths 700:400:3", "--wavelengths", in);
-    ExpectError("sample -m preetham --wavelengths 400:700:4", "per-wavelength", in);
+    ExpectError("sample -m neural --wavelengths 400:700:4", "per-wavelength", in);
     ExpectError("render -m naive --wavelengths 400:700:x -o " + (TempDir() / "s.exr").string(),
                 "--wavelengths");
 }
@@ -668,6 +669,47 @@ TEST(Cli, RenderWavelengthsWritesTheSpectralExr) {
     for (const char* name : {"S0.400nm", "S0.500nm", "S0.700nm", "spectralLayoutVersion"}) {
         EXPECT_NE(bytes.find(name), std::string::npos) << name;
     }
+}
+
+// Issue 17 item 2: preetham renders and samples with --wavelengths through its
+// own spectral form (the CIE daylight spectrum); the sampled Y in cd m^-2 is the
+// RGB sample's luminance x 683 x 106.86 nm (unit sun) up to the 10 nm quadrature.
+TEST(Cli, PreethamWavelengths) {
+    const std::string in =
+        "altitude_m,mu,mu_s,azimuth_deg\n0,0.5,0.7,90\n0,0,0,0\n0,0.05,-0.1,10\n"
+        "1000,0.9,0.2,180\n";
+    const Result rgb = RunAtmos("sample -m preetham", in);
+    const Result spectral = RunAtmos("sample -m preetham --wavelengths 380:780:41", in);
+    ASSERT_EQ(rgb.status, 0) << rgb.err;
+    ASSERT_EQ(spectral.status, 0) << spectral.err;
+    std::istringstream a(rgb.out), b(spectral.out);
+    std::string la, lb;
+    std::getline(a, la);
+    std::getline(b, lb);
+    int rows = 0;
+    while (std::getline(a, la) && std::getline(b, lb)) {
+        std::vector<double> va, vb;
+        std::stringstream fa(la), fb(lb);
+        for (std::string f; std::getline(fa, f, ',');) va.push_back(std::stod(f));
+        for (std::string f; std::getline(fb, f, ',');) vb.push_back(std::stod(f));
+        ASSERT_EQ(vb.size(), 4u + 41u + 3u) << lb;
+        for (size_t i = 4; i < vb.size(); ++i) EXPECT_TRUE(std::isfinite(vb[i]) && vb[i] >= 0.0);
+        const double y_rgb = 0.2126729 * va[4] + 0.7151522 * va[5] + 0.0721750 * va[6];
+        const double y = vb[4 + 41 + 1] / (683.0 * 106.856895);
+        EXPECT_NEAR(y / y_rgb, 1.0, 1e-3) << la << "\n" << lb;  // measured 3.4e-4
+        ++rows;
+    }
+    EXPECT_EQ(rows, 4);
+    const fs::path out = TempDir() / "preetham_spectral.exr";
+    const Result r = RunAtmos(
+        "render -m preetham -a earth-spectral --sun-disc --wavelengths "
+        "380:780:41 -s 16x9 -q -o " +
+        out.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(fs::exists(TempDir() / "preetham_spectral.spectral.exr"));
+    ExpectError("sample -m preetham --wavelengths 250:400:3", "outside the CIE daylight", in);
+    ExpectError("render -m preetham --wavelengths 400:900:3 -o " + out.string(),
+                "outside the CIE daylight");
 }
 
 // Issue 17: `validate kider-2013` on two captures (tests/data/kider-2013, a
@@ -804,7 +846,7 @@ TEST(Cli, CompareWavelengths) {
     const std::string flip = Slurp(out / "flip.csv");
     EXPECT_NE(flip.find("ground-noon,"), std::string::npos) << flip;
     ExpectError(
-        "compare -q --no-cache --models preetham --reference naive --wavelengths 400:700:4 "
+        "compare -q --no-cache --models neural --reference naive --wavelengths 400:700:4 "
         "-o " +
             out.string(),
         "per-wavelength");

@@ -136,7 +136,7 @@ TEST(Spectral, BatchesOfThreeCoverEveryWavelength) {
         EXPECT_EQ(all[i], one[0]) << nm[i];
         EXPECT_GT(one[0], 0.0);
     }
-    EXPECT_THROW(SampleSpectral(ParseModelSpec("preetham"), a, nm, queries, {}, prepare), Error);
+    EXPECT_THROW(SampleSpectral(ParseModelSpec("neural"), a, nm, queries, {}, prepare), Error);
 }
 
 TEST(Spectral, RequestsShareOnePreparePerBatch) {

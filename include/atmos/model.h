@@ -114,6 +114,7 @@ struct MonteCarloPass {
 };
 
 class Progress;
+struct SpectralAtmosphere;  // atmos/spectral.h
 
 struct RenderRequest {
     View view;
@@ -144,6 +145,13 @@ class Model {
     // Precomputation for the given atmosphere (tables, fits). Must be called
     // before Render / Sample; calling it again re-prepares.
     virtual void Prepare(const AtmosphereParameters& atmosphere) = 0;
+    // A spectral run (harness/spectral_run.h) calls this before each batch's
+    // Prepare(): the wavelengths (nm) its three channels stand for and the whole
+    // spectral atmosphere. The physical models take their per-wavelength
+    // coefficients from the batch's atmosphere and ignore it; a model with a
+    // spectral form of its own (preetham) builds it in the Prepare() that follows.
+    virtual void SetSpectralBatch(const SpectralAtmosphere& /*atmosphere*/,
+                                  const double /*nm*/[3]) {}
     // Renders the view's radiance (times the view's irradiance and the
     // atmosphere's solar irradiance) or transmittance into `out` (resized).
     virtual void Render(const RenderRequest& request, Image* out) const = 0;

@@ -26,6 +26,7 @@ std::unique_ptr<Model> PrepareBatch(const ModelSpec& spec, const SpectralAtmosph
     *batch = atmosphere.AtWavelengths(l[0], l[1], l[2]);
     std::unique_ptr<Model> model = CreateModel(spec);
     RequireSpectralModel(model->Info());
+    model->SetSpectralBatch(atmosphere, l);
     prepare(*batch, model.get());
     return model;
 }
@@ -43,15 +44,13 @@ uint64_t BatchSeed(uint64_t seed, size_t batch, BatchSeeds seeds) {
     return seeds == BatchSeeds::kSame ? seed : seed + (static_cast<uint64_t>(batch) << 40);
 }
 
-bool HasSpectralForm(const ModelInfo& info) {
-    return info.name != "preetham" && info.name != "neural";
-}
+bool HasSpectralForm(const ModelInfo& info) { return info.name != "neural"; }
 
 void RequireSpectralModel(const ModelInfo& info) {
     if (!HasSpectralForm(info)) {
         Fail("model ", info.name,
              " has no per-wavelength form in atmos (its inputs are not an atmosphere's "
-             "coefficients); --wavelengths takes the physical models");
+             "coefficients); --wavelengths takes the physical models and preetham");
     }
 }
 

@@ -40,8 +40,9 @@ uint64_t BatchSeed(uint64_t seed, size_t batch, BatchSeeds seeds);
 // Prepare()s a model for one batch's atmosphere (the CLI passes its PrepareModel).
 using PrepareFunction = std::function<void(const AtmosphereParameters&, Model*)>;
 
-// Fails (atmos::Error) for models without per-wavelength coefficients (preetham,
-// neural: their inputs are not an atmosphere's coefficients).
+// Fails (atmos::Error) for models without a per-wavelength form (neural: its
+// inputs are not an atmosphere's coefficients). Preetham has its own (the CIE
+// daylight basis; Model::SetSpectralBatch).
 bool HasSpectralForm(const ModelInfo& info);
 void RequireSpectralModel(const ModelInfo& info);
 

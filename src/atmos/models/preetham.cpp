@@ -1,6 +1,56 @@
 #include "models/preetham.h"
 
+#include <vector>
+
+#include "atmos/error.h"
+#include "atmos/spectral.h"
+
 namespace atmos {
+
+namespace {
+
+// data/spectra/cie-daylight-components.csv: CIE 15:2004 Table T.2, 10 nm.
+struct DaylightComponents {
+    std::vector<double> nm;
+    std::vector<double> s[3];
+};
+
+const DaylightComponents& Components() {
+    static const DaylightComponents table = [] {
+        DaylightComponents c;
+        for (int k = 0; k < 3; ++k) {
+            SpectralDataTable("cie-daylight-components", k, &c.nm, &c.s[k]);
+        }
+        return c;
+    }();
+    return table;
+}
+
+}  // namespace
+
+double CieDaylightComponent(int k, double nm) {
+    const DaylightComponents& c = Components();
+    if (k < 0 || k > 2) Fail("CIE daylight component ", k, ": expected 0, 1 or 2");
+    if (!(nm >= c.nm.front() && nm <= c.nm.back())) {
+        Fail("model preetham: ", WavelengthLabel(nm),
+             " nm is outside the CIE daylight components (", WavelengthLabel(c.nm.front()), "-",
+             WavelengthLabel(c.nm.back()), " nm) of its spectral form");
+    }
+    const std::vector<double>& s = c.s[k];
+    size_t i = 1;
+    while (i + 1 < c.nm.size() && c.nm[i] < nm) ++i;
+    const double t = (nm - c.nm[i - 1]) / (c.nm[i] - c.nm[i - 1]);
+    return s[i - 1] + t * (s[i] - s[i - 1]);
+}
+
+double PipelineLuminance(const std::function<double(double)>& f) {
+    std::vector<double> nm, ybar;
+    SpectralDataTable("cie1931-2deg", 1, &nm, &ybar);
+    const std::vector<double> w = WavelengthWeights(nm);
+    double sum = 0.0;
+    for (size_t i = 0; i < nm.size(); ++i) sum += f(nm[i]) * ybar[i] * w[i];
+    return sum / CieYIntegral();
+}
 
 double PreethamZenithLuminance(double T, double theta_s) {
     PreethamEvaluator e;
@@ -24,7 +74,7 @@ ModelInfo PreethamModel::StaticInfo() {
     info.title = "Preetham, Shirley & Smits 1999 analytic daylight";
     info.citation =
         "Preetham, Shirley & Smits 1999; Perez et al. 1993; seed 003 sections 5.3 (Eq. 32-34), "
-        "11.2.5";
+        "11.2.5; spectral form: CIE 15:2004 daylight components (Judd et al. 1964)";
     info.summary =
         "fitted Perez sky (xyY from turbidity) for a ground viewer; luminance / 128 klx as "
         "radiance per unit irradiance";
@@ -55,6 +105,30 @@ void PreethamModel::Prepare(const AtmosphereParameters& atmosphere) {
     SetAtmosphere(atmosphere);
     evaluator_.bottom = atmosphere.bottom_radius;
     evaluator_.top = atmosphere.top_radius;
+    evaluator_.spectral = spectral_;
+    if (!spectral_) return;
+    for (int k = 0; k < 3; ++k) {
+        evaluator_.basis_y[k] =
+            PipelineLuminance([k](double l) { return CieDaylightComponent(k, l); });
+    }
+    for (int c = 0; c < 3; ++c) {
+        for (int k = 0; k < 3; ++k) evaluator_.basis[c][k] = CieDaylightComponent(k, nm_[c]);
+        const double e = atmosphere.solar_irradiance[c];
+        evaluator_.channel_scale[c] = e > 0.0 ? solar_y_ / e : 0.0;
+    }
+}
+
+void PreethamModel::SetSpectralBatch(const SpectralAtmosphere& atmosphere, const double nm[3]) {
+    for (int c = 0; c < 3; ++c) {
+        CieDaylightComponent(0, nm[c]);  // fails outside the table
+        nm_[c] = nm[c];
+    }
+    solar_y_ = PipelineLuminance([&](double l) { return atmosphere.solar_irradiance.At(l); });
+    if (!(solar_y_ > 0.0)) {
+        Fail("model preetham: the solar spectrum of atmosphere '", atmosphere.name,
+             "' has no luminance (its Y over 360-830 nm is ", solar_y_, ")");
+    }
+    spectral_ = true;
 }
 
 }  // namespace atmos

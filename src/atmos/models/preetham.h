@@ -29,7 +29,23 @@
 // horizon (cos theta clamped to 0.001); a ray that hits the ground, or misses
 // the atmosphere, gets no sky. It has no transmittance (capabilities:
 // transmittance = false; 1 is reported for sky rays) and no ground term.
+//
+// Spectral form (`--wavelengths`; Preetham et al. 1999 section 3 and appendix
+// A.2 turn xyY into a spectrum the same way): the sky's spectrum is the CIE
+// daylight spectrum of its chromaticity, S(lambda) = S0 + M1 S1 + M2 S2
+// (CIE 15:2004 section 3.1 eqs. 3.5-3.6 after Judd, MacAdam & Wyszecki 1964;
+// components from data/spectra/cie-daylight-components.csv, 300-830 nm every
+// 10 nm, linear in between), scaled so that its Y (the spectral pipeline's
+// convention: sum over the CIE 1931 table's 5 nm wavelengths of S y-bar w,
+// divided by CieYIntegral()) is L times the Y of the atmosphere's solar
+// spectrum (1 for an RGB atmosphere): the luminance per unit solar
+// illuminance of the RGB form, times the sun. Each channel then holds that
+// spectrum at its wavelength divided by the solar irradiance there (radiance
+// per unit irradiance: the render and sample loops multiply it back). Values
+// below 0 (M1, M2 of chromaticities far from daylight) are clamped to 0.
 #pragma once
+
+#include <functional>
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
@@ -73,6 +89,26 @@ double PreethamZenithY(double T, double theta_s);
 // Extraterrestrial solar illuminance (lm/m^2) the radiance scale divides by.
 constexpr double kPreethamSolarIlluminance = 128e3;
 
+// CIE 15:2004 eqs. (3.5)-(3.6) (Judd, MacAdam & Wyszecki 1964): the weights M1,
+// M2 of the daylight components S1, S2 for chromaticity (x, y). False where
+// the denominator vanishes (far from any daylight chromaticity).
+ATMOS_HD inline bool CieDaylightWeights(double x, double y, double* m1, double* m2) {
+    const double m = 0.0241 + 0.2562 * x - 0.7341 * y;
+    if (!(Abs(m) > 1e-9)) return false;
+    *m1 = (-1.3515 - 1.7703 * x + 5.9114 * y) / m;
+    *m2 = (0.0300 - 31.4424 * x + 30.0717 * y) / m;
+    return true;
+}
+
+// The CIE daylight component S_k (k = 0, 1, 2) at `nm`: the linear
+// interpolation of data/spectra/cie-daylight-components.csv; atmos::Error
+// outside its 300-830 nm.
+double CieDaylightComponent(int k, double nm);
+// Y of the spectrum f(nm) in the spectral pipeline's convention (the sum over
+// the CIE 1931 table's wavelengths, 360-830 nm every 5 nm, of f y-bar w,
+// divided by CieYIntegral(): a flat spectrum 1 has Y = 1).
+double PipelineLuminance(const std::function<double(double)>& f);
+
 // The terms of one view that depend on the sun and the camera's up only.
 struct PreethamSunTerms {
     Vec3d s;                                 // the sun, raised to the horizon when below it
@@ -91,6 +127,12 @@ struct PreethamEvaluator {
     bool has_view = false;
     Vec3d view_camera, view_sun;
     PreethamSunTerms view;
+    // Spectral batch (PreethamModel::SetSpectralBatch, then Prepare): the
+    // channels are three wavelengths of the daylight spectrum, not sRGB.
+    bool spectral = false;
+    double basis[3][3] = {};       // basis[c][k]: S_k at channel c's wavelength
+    double basis_y[3] = {};        // Y of S_k (PipelineLuminance)
+    double channel_scale[3] = {};  // the sun's Y / its irradiance at channel c (0 where 0)
 
     ATMOS_HD PreethamSunTerms SunTerms(const Vec3d& up, const Vec3d& sun) const {
         PreethamSunTerms t;
@@ -132,13 +174,26 @@ struct PreethamEvaluator {
                                camera.z == view_camera.z && sun.x == view_sun.x &&
                                sun.y == view_sun.y && sun.z == view_sun.z;
         const PreethamSunTerms st = same_view ? view : SunTerms(up, sun);
+        double L = 0.0, x = 0.0, y = 0.0;
+        SkyXyY(st, up, dir, &L, &x, &y);
+        out.sky = spectral ? DaylightChannels(L, x, y) : XyYToSrgb(L, x, y);
+        return out;
+    }
+
+    // The sky's luminance per unit solar illuminance L (Y[kcd/m^2] 1000 /
+    // 128 klx, >= 0) and chromaticity (x, y) toward `dir` (Eq. 32-34).
+    ATMOS_HD void SkyXyY(const PreethamSunTerms& st, const Vec3d& up, const Vec3d& dir, double* L,
+                         double* x, double* y) const {
         const double cos_theta = Max(Dot(dir, up), 0.001);
         const double gamma = acos(Clamp(Dot(dir, st.s), -1.0, 1.0));
         const double Y = st.Yz * PerezF(kY, cos_theta, gamma) / st.fY0;
-        const double x = st.xz * PerezF(kx, cos_theta, gamma) / st.fx0;
-        const double y = st.yz * PerezF(ky, cos_theta, gamma) / st.fy0;
-        // xyY -> XYZ (radiance units: kcd/m^2 -> per unit solar irradiance).
-        const double L = Max(Y, 0.0) * 1000.0 / kPreethamSolarIlluminance;
+        *x = st.xz * PerezF(kx, cos_theta, gamma) / st.fx0;
+        *y = st.yz * PerezF(ky, cos_theta, gamma) / st.fy0;
+        *L = Max(Y, 0.0) * 1000.0 / kPreethamSolarIlluminance;
+    }
+
+    // The RGB form: xyY -> XYZ -> linear sRGB.
+    ATMOS_HD static Rgb XyYToSrgb(double L, double x, double y) {
         const double yy = Max(y, 1e-6);
         const double X = x / yy * L;
         const double Z = (1.0 - x - y) / yy * L;
@@ -146,9 +201,24 @@ struct PreethamEvaluator {
         const double R = 3.2404542 * X - 1.5371385 * L - 0.4985314 * Z;
         const double G = -0.9692660 * X + 1.8760108 * L + 0.0415560 * Z;
         const double B = 0.0556434 * X - 0.2040259 * L + 1.0572252 * Z;
-        out.sky = Rgb(static_cast<float>(Max(R, 0.0)), static_cast<float>(Max(G, 0.0)),
-                      static_cast<float>(Max(B, 0.0)));
-        return out;
+        return Rgb(static_cast<float>(Max(R, 0.0)), static_cast<float>(Max(G, 0.0)),
+                   static_cast<float>(Max(B, 0.0)));
+    }
+
+    // The spectral form: the daylight spectrum of (x, y) with Y = L x the sun's
+    // Y, at the batch's three wavelengths, per unit solar irradiance there;
+    // clamped to >= 0.
+    ATMOS_HD Rgb DaylightChannels(double L, double x, double y) const {
+        double m1 = 0.0, m2 = 0.0;
+        if (!(L > 0.0) || !CieDaylightWeights(x, y, &m1, &m2)) return Rgb(0.0f);
+        const double sy = basis_y[0] + m1 * basis_y[1] + m2 * basis_y[2];
+        if (!(sy > 0.0)) return Rgb(0.0f);
+        float v[3];
+        for (int c = 0; c < 3; ++c) {
+            const double s = basis[c][0] + m1 * basis[c][1] + m2 * basis[c][2];
+            v[c] = static_cast<float>(Max(L * s / sy * channel_scale[c], 0.0));
+        }
+        return Rgb(v[0], v[1], v[2]);
     }
 
     ATMOS_HD double ZenithLuminance(double theta_s) const {
@@ -186,6 +256,14 @@ class PreethamModel : public SimpleEvaluatorModel<PreethamModel, PreethamEvaluat
     explicit PreethamModel(const PreethamOptions& options);
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override;
+    // The batch's wavelengths (atmos::Error outside the components' 300-830 nm)
+    // and the Y of the solar spectrum; the next Prepare() builds the spectral form.
+    void SetSpectralBatch(const SpectralAtmosphere& atmosphere, const double nm[3]) override;
+
+  private:
+    bool spectral_ = false;
+    double nm_[3] = {};
+    double solar_y_ = 1.0;
 };
 
 }  // namespace atmos
