@@ -25,7 +25,7 @@ constexpr AerosolParameter kAerosolParameters[4] = {
 };
 
 struct AerosolFitSettings {
-    std::string model = "hillaire";  // a model spec; Monte Carlo models use `monte_carlo`
+    std::string model = "reference";  // a model spec; Monte Carlo models use `monte_carlo`
     MonteCarloSettings monte_carlo;
     std::vector<double> nm;  // Kider bins (nm) the fit compares
     int max_evaluations = 40;

@@ -87,6 +87,7 @@ SampleQuery KiderQuery(const KiderSample& sample, bool theory_azimuth) {
 }
 
 const char* KiderRegion(const KiderSample& sample) {
+    if (sample.gamma_deg < 10.0) return "near-sun";
     if (sample.gamma_deg < 25.0) return "aureole";
     if (sample.view_zenith_deg < 1.0) return "zenith";
     if (sample.elevation_deg < 15.0) return "horizon";
