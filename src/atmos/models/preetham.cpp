@@ -9,17 +9,26 @@ namespace atmos {
 
 namespace {
 
-// data/spectra/cie-daylight-components.csv: CIE 15:2004 Table T.2, 10 nm.
+// data/spectra/cie-daylight-components.csv: CIE 15:2004 Table T.2, 10 nm, as
+// three tabulated spectra (linear between the rows), and the Y of each.
 struct DaylightComponents {
-    std::vector<double> nm;
-    std::vector<double> s[3];
+    double first_nm = 0.0, last_nm = 0.0;
+    Spectrum s[3];
+    double y[3] = {};
 };
 
 const DaylightComponents& Components() {
     static const DaylightComponents table = [] {
         DaylightComponents c;
         for (int k = 0; k < 3; ++k) {
-            SpectralDataTable("cie-daylight-components", k, &c.nm, &c.s[k]);
+            std::vector<double> nm, values;
+            SpectralDataTable("cie-daylight-components", k, &nm, &values);
+            c.first_nm = nm.front();
+            c.last_nm = nm.back();
+            c.s[k] = Spectrum::Table(std::move(nm), std::move(values));
+        }
+        for (int k = 0; k < 3; ++k) {
+            c.y[k] = PipelineLuminance([&c, k](double l) { return c.s[k].At(l); });
         }
         return c;
     }();
@@ -31,25 +40,20 @@ const DaylightComponents& Components() {
 double CieDaylightComponent(int k, double nm) {
     const DaylightComponents& c = Components();
     if (k < 0 || k > 2) Fail("CIE daylight component ", k, ": expected 0, 1 or 2");
-    if (!(nm >= c.nm.front() && nm <= c.nm.back())) {
+    if (!(nm >= c.first_nm && nm <= c.last_nm)) {
         Fail("model preetham: ", WavelengthLabel(nm),
-             " nm is outside the CIE daylight components (", WavelengthLabel(c.nm.front()), "-",
-             WavelengthLabel(c.nm.back()), " nm) of its spectral form");
+             " nm is outside the CIE daylight components (", WavelengthLabel(c.first_nm), "-",
+             WavelengthLabel(c.last_nm), " nm) of its spectral form");
     }
-    const std::vector<double>& s = c.s[k];
-    size_t i = 1;
-    while (i + 1 < c.nm.size() && c.nm[i] < nm) ++i;
-    const double t = (nm - c.nm[i - 1]) / (c.nm[i] - c.nm[i - 1]);
-    return s[i - 1] + t * (s[i] - s[i - 1]);
+    return c.s[k].At(nm);
 }
 
 double PipelineLuminance(const std::function<double(double)>& f) {
-    std::vector<double> nm, ybar;
+    std::vector<double> nm, ybar;  // the CIE table's wavelengths (ybar: SpectrumToXyz's own)
     SpectralDataTable("cie1931-2deg", 1, &nm, &ybar);
-    const std::vector<double> w = WavelengthWeights(nm);
-    double sum = 0.0;
-    for (size_t i = 0; i < nm.size(); ++i) sum += f(nm[i]) * ybar[i] * w[i];
-    return sum / CieYIntegral();
+    std::vector<double> values(nm.size());
+    for (size_t i = 0; i < nm.size(); ++i) values[i] = f(nm[i]);
+    return SpectrumToXyz(nm, WavelengthWeights(nm), values.data()).y / CieYIntegral();
 }
 
 double PreethamZenithLuminance(double T, double theta_s) {
@@ -107,10 +111,7 @@ void PreethamModel::Prepare(const AtmosphereParameters& atmosphere) {
     evaluator_.top = atmosphere.top_radius;
     evaluator_.spectral = spectral_;
     if (!spectral_) return;
-    for (int k = 0; k < 3; ++k) {
-        evaluator_.basis_y[k] =
-            PipelineLuminance([k](double l) { return CieDaylightComponent(k, l); });
-    }
+    for (int k = 0; k < 3; ++k) evaluator_.basis_y[k] = Components().y[k];
     for (int c = 0; c < 3; ++c) {
         for (int k = 0; k < 3; ++k) evaluator_.basis[c][k] = CieDaylightComponent(k, nm_[c]);
         const double e = atmosphere.solar_irradiance[c];
