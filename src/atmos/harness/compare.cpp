@@ -437,13 +437,14 @@ CompareResult RunCompare(const CompareConfig& config) {
                              why.c_str());
             }
         }
-        if (row.reference_source != "shipped") {
+        const bool from_shipped = row.reference_source == "shipped";
+        if (!from_shipped) {
             ref = reference.Render(view, &row.reference_seconds, &row.reference_cached, &ref_report,
                                    &ref_variance);
             row.reference_spp = ref_report.samples;
             if (noise_target) row.reference_noise = ref_report.noise;
         }
-        if (split_reference && row.reference_source != "shipped") {
+        if (split_reference && !from_shipped) {
             double seconds_b = 0.0;
             bool cached_b = false;
             Image variance_b;

@@ -47,12 +47,28 @@ Json FingerprintFields(const ReferenceFingerprint& f) {
     return j;
 }
 
-// The fields a shipped set must share with a run (the atmosphere's label is
-// informative).
-bool SameFingerprint(const ReferenceFingerprint& a, const ReferenceFingerprint& b) {
-    return a.estimator_version == b.estimator_version && a.model == b.model &&
-           a.atmosphere_hash == b.atmosphere_hash && a.width == b.width && a.height == b.height &&
-           a.wavelengths == b.wavelengths && a.quantity == b.quantity;
+// Why a shipped set's fingerprint differs from a run's, one reason per field
+// (the atmosphere's label is informative, the view hashes are per view).
+std::vector<std::string> FingerprintMismatches(const ReferenceFingerprint& s,
+                                               const ReferenceFingerprint& run) {
+    std::vector<std::string> why;
+    if (s.estimator_version != run.estimator_version) {
+        why.push_back("estimator version differs (shipped " + std::to_string(s.estimator_version) +
+                      ", this build " + std::to_string(run.estimator_version) + ")");
+    }
+    if (s.model != run.model)
+        why.push_back("reference model options differ (shipped " + s.model + ")");
+    if (s.quantity != run.quantity) why.push_back("quantity differs (shipped " + s.quantity + ")");
+    if (s.wavelengths != run.wavelengths) {
+        why.push_back("wavelengths differ (shipped " + s.wavelengths + ")");
+    }
+    if (s.width != run.width || s.height != run.height) {
+        why.push_back("size differs (shipped " + SizeText(s.width, s.height) + ")");
+    }
+    if (s.atmosphere_hash != run.atmosphere_hash) {
+        why.push_back("atmosphere differs (shipped " + s.atmosphere + ")");
+    }
+    return why;
 }
 
 // One JSON text: top-level fields a line, the fingerprint indented, a view a line.
@@ -132,19 +148,26 @@ const ShippedView* ShippedReferences::Find(const std::string& view) const {
     return nullptr;
 }
 
-ShippedReferences ReadShippedReferences(const std::string& directory) {
+namespace {
+
+// DIR/provenance.json as JSON (atmos::Error when unreadable or not JSON).
+Json ReadProvenanceJson(const std::string& directory) {
     const fs::path path = fs::path(directory) / "provenance.json";
     const std::string where = path.string();
     std::ifstream in(path);
     if (!in) Fail(where, ": cannot be read");
-    Json j;
     try {
-        j = Json::parse(in);
+        return Json::parse(in);
     } catch (const std::exception& e) {
         const std::string what = e.what();
         const size_t end = what.find("] ");
         Fail(where, ": invalid JSON: ", end == std::string::npos ? what : what.substr(end + 2));
     }
+}
+
+// The validated contents of `j`, read from DIR/provenance.json.
+ShippedReferences ShippedFromJson(const Json& j, const std::string& directory) {
+    const std::string where = (fs::path(directory) / "provenance.json").string();
     if (j.is_object() && !j.contains("format")) {
         Fail(where,
              ": written by an older atmos (no format field); regenerate it with "
@@ -191,26 +214,15 @@ ShippedReferences ReadShippedReferences(const std::string& directory) {
     return s;
 }
 
+}  // namespace
+
+ShippedReferences ReadShippedReferences(const std::string& directory) {
+    return ShippedFromJson(ReadProvenanceJson(directory), directory);
+}
+
 std::string ShippedMismatch(const ShippedReferences& shipped, const ReferenceFingerprint& run,
                             const std::string& view, double noise_target, int64_t spp) {
-    const ReferenceFingerprint& s = shipped.fingerprint;
-    std::vector<std::string> why;
-    if (s.estimator_version != run.estimator_version) {
-        why.push_back("estimator version differs (shipped " + std::to_string(s.estimator_version) +
-                      ", this build " + std::to_string(run.estimator_version) + ")");
-    }
-    if (s.model != run.model)
-        why.push_back("reference model options differ (shipped " + s.model + ")");
-    if (s.quantity != run.quantity) why.push_back("quantity differs (shipped " + s.quantity + ")");
-    if (s.wavelengths != run.wavelengths) {
-        why.push_back("wavelengths differ (shipped " + s.wavelengths + ")");
-    }
-    if (s.width != run.width || s.height != run.height) {
-        why.push_back("size differs (shipped " + SizeText(s.width, s.height) + ")");
-    }
-    if (s.atmosphere_hash != run.atmosphere_hash) {
-        why.push_back("atmosphere differs (shipped " + s.atmosphere + ")");
-    }
+    std::vector<std::string> why = FingerprintMismatches(shipped.fingerprint, run);
     const ShippedView* v = shipped.Find(view);
     const auto hash = run.view_hashes.find(view);
     if (!v) {
@@ -280,10 +292,9 @@ void RecordShippedView(const std::string& directory, const ReferenceFingerprint&
     std::error_code ec;
     if (fs::exists(path, ec)) {
         try {
-            const ShippedReferences old = ReadShippedReferences(directory);
-            if (SameFingerprint(old.fingerprint, run)) {
-                std::ifstream in(path);
-                const Json file = Json::parse(in);
+            const Json file = ReadProvenanceJson(directory);
+            const ShippedReferences old = ShippedFromJson(file, directory);
+            if (FingerprintMismatches(old.fingerprint, run).empty()) {
                 for (const Json& v : file.at("views")) views.push_back(v);
             }
         } catch (const Error&) {
