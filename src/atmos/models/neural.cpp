@@ -24,18 +24,6 @@ namespace {
 
 constexpr const char* kFormat = "atmos-neural-1";
 
-const char* EncodingName(NeuralEncoding e) {
-    switch (e) {
-        case NeuralEncoding::kThesis:
-            return "thesis";
-        case NeuralEncoding::kExtended:
-            return "extended";
-        case NeuralEncoding::kHorizon:
-            return "horizon";
-    }
-    return "thesis";
-}
-
 using json = nlohmann::json;
 
 template <typename Net>
@@ -161,6 +149,29 @@ bool Close(const Vec3d& a, const Vec3d& b) {
 
 }  // namespace
 
+const char* NeuralEncodingName(NeuralEncoding encoding) {
+    switch (encoding) {
+        case NeuralEncoding::kThesis:
+            return "thesis";
+        case NeuralEncoding::kExtended:
+            return "extended";
+        case NeuralEncoding::kHorizon:
+            return "horizon";
+    }
+    return "thesis";
+}
+
+bool ParseNeuralEncoding(const std::string& name, NeuralEncoding* encoding) {
+    for (NeuralEncoding e :
+         {NeuralEncoding::kThesis, NeuralEncoding::kExtended, NeuralEncoding::kHorizon}) {
+        if (name == NeuralEncodingName(e)) {
+            *encoding = e;
+            return true;
+        }
+    }
+    return false;
+}
+
 NeuralWeights NeuralWeightsFromJson(const std::string& text, const std::string& source) {
     json j;
     try {
@@ -174,13 +185,7 @@ NeuralWeights NeuralWeightsFromJson(const std::string& text, const std::string& 
         }
         NeuralWeights w;
         const std::string enc = j.value("encoding", "");
-        if (enc == "thesis") {
-            w.encoding = NeuralEncoding::kThesis;
-        } else if (enc == "extended") {
-            w.encoding = NeuralEncoding::kExtended;
-        } else if (enc == "horizon") {
-            w.encoding = NeuralEncoding::kHorizon;
-        } else {
+        if (!ParseNeuralEncoding(enc, &w.encoding)) {
             Fail("encoding: expected 'thesis', 'extended' or 'horizon', got '", enc, "'");
         }
         if (!j.contains("atmosphere") || !j["atmosphere"].is_object()) Fail("atmosphere: missing");
@@ -228,7 +233,7 @@ NeuralWeights NeuralWeightsFromJson(const std::string& text, const std::string& 
 std::string NeuralWeightsToJson(const NeuralWeights& w) {
     json j;
     j["format"] = kFormat;
-    j["encoding"] = EncodingName(w.encoding);
+    j["encoding"] = NeuralEncodingName(w.encoding);
     json a;
     a["bottom_radius"] = w.bottom_radius;
     a["top_radius"] = w.top_radius;

@@ -152,6 +152,12 @@ struct NeuralWeights {
 
 // JSON (nlohmann_json): parse / write. Parse throws atmos::Error naming the
 // first problem (`source` names the file in messages).
+// The encodings' names in weight files and `atmos fit --encoding`: thesis,
+// extended, horizon.
+const char* NeuralEncodingName(NeuralEncoding encoding);
+// The encoding named `name`; false for any other text.
+bool ParseNeuralEncoding(const std::string& name, NeuralEncoding* encoding);
+
 NeuralWeights NeuralWeightsFromJson(const std::string& text, const std::string& source);
 std::string NeuralWeightsToJson(const NeuralWeights& weights);
 NeuralWeights LoadNeuralWeights(const std::string& path);

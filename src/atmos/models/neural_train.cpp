@@ -274,13 +274,15 @@ NeuralFitChoices CheckNeuralFitOptions(const NeuralFitOptions& o) {
     NeuralFitChoices c;
     NeuralEncoding& enc = c.encoding;
     enc = large ? NeuralEncoding::kHorizon : NeuralEncoding::kThesis;
-    if (o.encoding == "extended" || o.encoding == "horizon") {
-        if (!large) Fail("fit: --encoding ", o.encoding, " needs --network large");
-        enc = o.encoding == "extended" ? NeuralEncoding::kExtended : NeuralEncoding::kHorizon;
-    } else if (!o.encoding.empty() && o.encoding != "thesis") {
-        Fail("fit: --encoding must be thesis, extended or horizon, got '", o.encoding, "'");
-    } else if (o.encoding == "thesis" && large) {
-        Fail("fit: --encoding thesis needs --network thesis");
+    if (!o.encoding.empty()) {
+        NeuralEncoding chosen = enc;
+        if (!ParseNeuralEncoding(o.encoding, &chosen)) {
+            Fail("fit: --encoding must be thesis, extended or horizon, got '", o.encoding, "'");
+        }
+        const bool thesis = chosen == NeuralEncoding::kThesis;
+        if (!thesis && !large) Fail("fit: --encoding ", o.encoding, " needs --network large");
+        if (thesis && large) Fail("fit: --encoding thesis needs --network thesis");
+        enc = chosen;
     }
     double& horizon_fraction = c.horizon_fraction;
     horizon_fraction = o.horizon_fraction ? *o.horizon_fraction : (large ? 0.25 : 0.0);
@@ -427,9 +429,7 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     w.fit_atmosphere = atm;
     nlohmann::json tj;
     tj["network"] = o.network;
-    tj["encoding"] = enc == NeuralEncoding::kThesis     ? "thesis"
-                     : enc == NeuralEncoding::kExtended ? "extended"
-                                                        : "horizon";
+    tj["encoding"] = NeuralEncodingName(enc);
     tj["horizon_fraction"] = horizon_fraction;
     tj["transmittance_samples"] = o.transmittance_samples;
     tj["scattering_samples"] = o.scattering_samples;
