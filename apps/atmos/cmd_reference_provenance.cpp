@@ -75,16 +75,10 @@ int CmdReferenceProvenance(const ProvenanceOptions& o) {
         }
     }
     for (const View& view : views) {
-        std::string why =
-            shipped ? ShippedMismatch(*shipped, fingerprint, view.name, o.noise, o.cap) : unusable;
-        if (why.empty()) {
-            try {
-                Image image, variance;
-                LoadShippedImages(*shipped, view.name, width, height, &image, &variance);
-            } catch (const std::exception& e) {
-                why = e.what();
-            }
-        }
+        Image image, variance;
+        const std::string why = shipped ? LoadMatchingShippedView(*shipped, fingerprint, view.name,
+                                                                  o.noise, o.cap, &image, &variance)
+                                        : unusable;
         if (why.empty()) {
             const ShippedView& v = *shipped->Find(view.name);
             std::fprintf(stderr, "%s: shipped reference kept (%lld paths per pixel, noise %.4g)\n",

@@ -413,26 +413,18 @@ CompareResult RunCompare(const CompareConfig& config) {
             // The shipped image when it matches the run and is at least as good as
             // the run's render would be (its noise at or below the target, or at
             // least the run's paths per pixel).
-            std::string why = ShippedMismatch(*shipped, run_fingerprint, view.name,
-                                              noise_target ? mc.noise_target : 0.0, mc.spp);
+            const std::string why = LoadMatchingShippedView(*shipped, run_fingerprint, view.name,
+                                                            noise_target ? mc.noise_target : 0.0,
+                                                            mc.spp, &ref, &ref_variance);
             if (why.empty()) {
-                try {
-                    LoadShippedImages(*shipped, view.name, config.width, config.height, &ref,
-                                      &ref_variance);
-                    const ShippedView& v = *shipped->Find(view.name);
-                    row.reference_source = "shipped";
-                    row.reference_spp = v.paths_per_pixel;
-                    row.reference_noise = v.noise;
-                    row.reference_provenance =
-                        (fs::path(shipped->directory) / "provenance.json").string() +
-                        (v.commit.empty() ? "" : " (commit " + v.commit.substr(0, 12) + ")");
-                } catch (const std::exception& e) {
-                    why = e.what();
-                    ref = Image();
-                    ref_variance = Image();
-                }
-            }
-            if (!why.empty()) {
+                const ShippedView& v = *shipped->Find(view.name);
+                row.reference_source = "shipped";
+                row.reference_spp = v.paths_per_pixel;
+                row.reference_noise = v.noise;
+                row.reference_provenance =
+                    (fs::path(shipped->directory) / "provenance.json").string() +
+                    (v.commit.empty() ? "" : " (commit " + v.commit.substr(0, 12) + ")");
+            } else {
                 std::fprintf(stderr, "%s: shipped reference not used: %s\n", view.name.c_str(),
                              why.c_str());
             }

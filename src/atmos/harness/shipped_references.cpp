@@ -268,6 +268,22 @@ void LoadShippedImages(const ShippedReferences& shipped, const std::string& view
     }
 }
 
+std::string LoadMatchingShippedView(const ShippedReferences& shipped,
+                                    const ReferenceFingerprint& run, const std::string& view,
+                                    double noise_target, int64_t spp, Image* image,
+                                    Image* variance) {
+    const std::string why = ShippedMismatch(shipped, run, view, noise_target, spp);
+    if (!why.empty()) return why;
+    try {
+        LoadShippedImages(shipped, view, run.width, run.height, image, variance);
+        return "";
+    } catch (const std::exception& e) {
+        *image = Image();
+        *variance = Image();
+        return e.what();
+    }
+}
+
 void RecordShippedView(const std::string& directory, const ReferenceFingerprint& run,
                        const std::string& entry_json) {
     Json entry;

@@ -103,6 +103,15 @@ std::string ShippedMismatch(const ShippedReferences& shipped, const ReferenceFin
 void LoadShippedImages(const ShippedReferences& shipped, const std::string& view, int width,
                        int height, Image* image, Image* variance);
 
+// ShippedMismatch, then LoadShippedImages: the shipped image and variance of
+// `view` in `image` and `variance` and "" when they stand for the run's
+// reference, else why not (a mismatch, or the load's error; the images are
+// left empty).
+std::string LoadMatchingShippedView(const ShippedReferences& shipped,
+                                    const ReferenceFingerprint& run, const std::string& view,
+                                    double noise_target, int64_t spp, Image* image,
+                                    Image* variance);
+
 // Adds (or replaces) one view's entry in DIR/provenance.json, written
 // atomically: `entry_json` is a JSON object with at least view (one of
 // `run`'s views), paths_per_pixel and noise; its view_hash is set from `run`.
