@@ -91,12 +91,14 @@ struct TableView {
 
     // Texture coordinate -> lower texel index and fraction toward the next one,
     // clamped to the edge texels.
+    // Selects, not branches: a loop of it under ATMOS_SIMD vectorises
+    // (Bruneton's precomputation rows).
     ATMOS_HD static void Split(double u, int size, int* i0, float* f) {
         double x = u * size - 0.5;
-        if (x < 0.0) x = 0.0;
-        if (x > size - 1) x = size - 1;
+        x = x < 0.0 ? 0.0 : x;
+        x = x > size - 1 ? size - 1 : x;
         int i = static_cast<int>(x);
-        if (i > size - 2) i = size > 1 ? size - 2 : 0;
+        i = i > size - 2 ? (size > 1 ? size - 2 : 0) : i;
         *i0 = i;
         *f = size > 1 ? static_cast<float>(x - i) : 0.0f;
     }

@@ -231,18 +231,6 @@ void RowMuSNu(const BrunetonLut& lut, int y, int z, int width, double* mu_s_x, d
     }
 }
 
-// TableView::Split (TexelSpan) for a loop body: lower texel and fraction.
-inline void SplitLane(double u, int size, int* i0, int* i1, float* f) {
-    double x = u * size - 0.5;
-    x = x < 0.0 ? 0.0 : x;
-    x = x > size - 1 ? size - 1 : x;
-    int i = static_cast<int>(x);
-    i = i > size - 2 ? (size > 1 ? size - 2 : 0) : i;
-    *i0 = i;
-    *i1 = i + 1 < size - 1 ? i + 1 : size - 1;
-    *f = size > 1 ? static_cast<float>(x - i) : 0.0f;
-}
-
 }  // namespace
 
 // Single scattering: per sample, the transmittance to the sun at every texel of
@@ -308,9 +296,9 @@ void ComputeBrunetonSingleScatteringRows(const BrunetonLut& lut, Table* rayleigh
                 const double d =
                     Max(-sr * mu_s_d + SafeSqrt(rr * (mu_s_d * mu_s_d - 1.0) + top2), 0.0);
                 const double u = u_off + ((d - d_min) / d_range) * u_scale;
-                int i0, i1;
-                float fx;
-                SplitLane(u, t_width, &i0, &i1, &fx);
+                const TexelSpan tx = SplitSpan(u, t_width);
+                const int i0 = tx.i0, i1 = tx.i1;
+                const float fx = tx.f;
                 const float* a0 = tdata + (row0 + i0) * 3;
                 const float* a1 = tdata + (row0 + i1) * 3;
                 const float* b0 = tdata + (row1 + i0) * 3;
@@ -407,10 +395,10 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
                 const double a = (d - kc.mu_s_d_min) * inv_d_range;
                 const double u_mu_s = kc.scattering_mu_s(Max(1.0 - a * inv_big_a, 0.0) / (1.0 + a));
                 // BrunetonSplitColumns: the two nu slices.
-                int a0, a1, b0, b1;
-                float fa, fb;
-                SplitLane((tex_x[k] + u_mu_s) * inv_nu, width, &a0, &a1, &fa);
-                SplitLane((tex_x[k] + 1.0 + u_mu_s) * inv_nu, width, &b0, &b1, &fb);
+                const TexelSpan sa = SplitSpan((tex_x[k] + u_mu_s) * inv_nu, width);
+                const TexelSpan sb = SplitSpan((tex_x[k] + 1.0 + u_mu_s) * inv_nu, width);
+                const int a0 = sa.i0, a1 = sa.i1, b0 = sb.i0, b1 = sb.i1;
+                const float fa = sa.f, fb = sb.f;
                 const float l = lerp[k];
                 float v[3];
                 for (int ch = 0; ch < 3; ++ch) {
