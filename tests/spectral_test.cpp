@@ -1,6 +1,7 @@
 // Spectral atmospheres, spectral runs and colour (issue 17).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -193,7 +194,8 @@ TEST(Spectral, BatchSeedsCorrelateOrSeparateTheBatches) {
     double gap[2] = {0.0, 0.0};
     for (const BatchSeeds seeds : {BatchSeeds::kSame, BatchSeeds::kDistinct}) {
         const std::vector<double> v =
-            SampleSpectral(ParseModelSpec("reference"), a, nm, queries, mc, prepare, seeds);
+            SampleSpectral(ParseModelSpec("reference"), a, nm, queries, mc, prepare,
+                           SpectralBatching{seeds, BatchLayout::kConsecutive});
         double sum = 0.0, mean = 0.0;
         for (size_t q = 0; q < queries.size(); ++q) {
             sum += std::abs(v[q * 6 + 3] - v[q * 6 + 2]);
@@ -207,6 +209,57 @@ TEST(Spectral, BatchSeedsCorrelateOrSeparateTheBatches) {
     EXPECT_EQ(BatchSeed(7, 3, BatchSeeds::kSame), 7u);
     EXPECT_EQ(BatchSeed(7, 3, BatchSeeds::kDistinct), 7u + (uint64_t{3} << 40));
     EXPECT_THROW(ParseBatchSeeds("other"), Error);
+}
+
+// Both layouts hold every wavelength in exactly one batch (a short batch repeats
+// an index it already holds), in ceil(N/3) batches; interleaved batches take
+// b, b + S, b + 2S.
+TEST(Spectral, BatchLayoutsHoldEveryWavelengthOnce) {
+    for (const BatchLayout layout : {BatchLayout::kConsecutive, BatchLayout::kInterleaved}) {
+        for (size_t n = 1; n <= 45; ++n) {
+            const std::vector<std::array<size_t, 3>> batches = SpectralBatches(n, layout);
+            ASSERT_EQ(batches.size(), (n + 2) / 3) << n;
+            std::vector<int> held(n, 0);
+            for (const std::array<size_t, 3>& b : batches) {
+                for (size_t c = 0; c < 3; ++c) {
+                    ASSERT_LT(b[c], n);
+                    bool repeat = false;
+                    for (size_t k = 0; k < c; ++k) repeat = repeat || b[k] == b[c];
+                    if (!repeat) ++held[b[c]];
+                }
+            }
+            for (size_t i = 0; i < n; ++i) EXPECT_EQ(held[i], 1) << "n " << n << " index " << i;
+        }
+    }
+    const std::vector<std::array<size_t, 3>> b40 = SpectralBatches(40, BatchLayout::kInterleaved);
+    EXPECT_EQ(b40[0], (std::array<size_t, 3>{0, 14, 28}));
+    EXPECT_EQ(b40[11], (std::array<size_t, 3>{11, 25, 39}));
+    EXPECT_EQ(b40[13], (std::array<size_t, 3>{13, 27, 27}));
+    EXPECT_EQ(SpectralBatches(40, BatchLayout::kConsecutive)[13],
+              (std::array<size_t, 3>{39, 39, 39}));
+    EXPECT_EQ(ParseBatchLayout("interleaved"), BatchLayout::kInterleaved);
+    EXPECT_THROW(ParseBatchLayout("hero"), Error);
+}
+
+// A deterministic model's value at a wavelength does not depend on which batch
+// carries it: the interleaved layout stores each batch's channels at their own
+// wavelengths (a swapped index would put a neighbour's value there).
+TEST(Spectral, InterleavedBatchesStoreEachWavelengthsOwnValue) {
+    const SpectralAtmosphere a = LoadSpectralAtmosphere("earth-spectral");
+    const auto prepare = [](const AtmosphereParameters& p, Model* m) { m->Prepare(p); };
+    const std::vector<double> nm = ParseWavelengths("380:780:11");
+    std::vector<SampleQuery> queries;
+    for (int i = 0; i < 6; ++i) queries.push_back({1000.0, 0.05 + 0.15 * i, 0.4, 40.0 * i});
+    const std::vector<double> consecutive =
+        SampleSpectral(ParseModelSpec("naive"), a, nm, queries, {}, prepare, SpectralBatching{});
+    const std::vector<double> interleaved =
+        SampleSpectral(ParseModelSpec("naive"), a, nm, queries, {}, prepare,
+                       SpectralBatching{BatchSeeds::kSame, BatchLayout::kInterleaved});
+    ASSERT_EQ(consecutive.size(), interleaved.size());
+    for (size_t i = 0; i < consecutive.size(); ++i) {
+        EXPECT_NEAR(interleaved[i], consecutive[i], 1e-5 * consecutive[i] + 1e-12)
+            << "query " << i / nm.size() << " at " << nm[i % nm.size()] << " nm";
+    }
 }
 
 TEST(Spectral, FilesAreValidatedNamingTheField) {

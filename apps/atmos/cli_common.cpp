@@ -95,16 +95,29 @@ RenderRequest ViewRequest(const View& view, int width, int height, Quantity quan
     return request;
 }
 
+SpectralBatching ParseSpectralBatching(const SpectralFlags& flags) {
+    SpectralBatching batching;
+    batching.seeds = ParseBatchSeeds(flags.batch_seeds);
+    batching.layout = ParseBatchLayout(flags.batch_layout);
+    return batching;
+}
+
 void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour) {
     cmd->add_option("--wavelengths", flags->wavelengths,
                     "spectral run: START:STOP:COUNT (nm, both ends included) or a list a,b,c; "
                     "the atmosphere is evaluated at each wavelength and the model run in "
                     "batches of three");
     cmd->add_option("--batch-seeds", flags->batch_seeds,
-                    "with --wavelengths, Monte Carlo models: same (every batch of three "
-                    "wavelengths uses the seed: correlated wavelengths, little colour noise) or "
-                    "distinct (batch b uses seed + b 2^40: independent batches, less luminance "
-                    "noise, more colour noise)")
+                    "with --wavelengths, Monte Carlo models: distinct (batch b uses seed + b "
+                    "2^40: independent batches) or same (every batch of three wavelengths uses "
+                    "the seed: less noise in each wavelength's own value with consecutive "
+                    "batches, more in colour)")
+        ->capture_default_str();
+    cmd->add_option(
+           "--batch-layout", flags->batch_layout,
+           "with --wavelengths: interleaved (batch b holds wavelengths b, b+S, b+2S "
+           "with S = ceil(N/3): hero-wavelength companions spread over the range; with "
+           "distinct seeds the least colour noise at equal time) or consecutive (3b..3b+2)")
         ->capture_default_str();
     if (!colour) return;
     cmd->add_option("--colour", flags->colour,

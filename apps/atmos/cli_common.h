@@ -15,6 +15,7 @@
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "atmos/view.h"
+#include "harness/spectral_run.h"
 
 namespace atmos::cli {
 
@@ -57,9 +58,12 @@ struct SpectralFlags {
     std::string wavelengths;
     std::string colour = "srgb";
     std::string white = "d65";
-    std::string batch_seeds = "same";  // harness/spectral_run.h BatchSeeds
+    std::string batch_seeds = "distinct";      // harness/spectral_run.h BatchSeeds
+    std::string batch_layout = "interleaved";  // harness/spectral_run.h BatchLayout
 };
 void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour = true);
+// --batch-seeds and --batch-layout as parsed values (throws on an unknown name).
+SpectralBatching ParseSpectralBatching(const SpectralFlags& flags);
 
 // The request of one view at a size and quantity with Monte Carlo settings, no
 // progress bar (callers set the rest).

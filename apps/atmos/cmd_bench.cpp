@@ -146,7 +146,7 @@ int BenchSpectral(const BenchOptions& o, const std::vector<ModelSpec>& models,
                         m->Prepare(a);
                         prepare_s += Seconds(p0);
                     },
-                    ParseBatchSeeds(o.spectral.batch_seeds));
+                    ParseSpectralBatching(o.spectral));
                 const double total = Seconds(t0);
                 sp.push_back(prepare_s);
                 sr.push_back(total - prepare_s);

@@ -120,7 +120,7 @@ int CmdCompare(const CompareCliOptions& o) {
     config.flip.tone_mapper = ParseFlipToneMapper(o.tone_mapper);
     config.flip.exposure_setup = ParseFlipExposureSetup(o.exposure);
     config.command_line = o.command_line;
-    config.batch_seeds = ParseBatchSeeds(o.spectral.batch_seeds);
+    config.batching = ParseSpectralBatching(o.spectral);
 
     // The reference: `reference` (the path tracer) when registered, else a stand-in.
     const bool monte_carlo_given =

@@ -55,7 +55,7 @@ int RenderSpectralViews(const CommonOptions& common, const RenderOptions& ro,
     const std::vector<double> nm = ParseWavelengths(ro.spectral.wavelengths);
     const ColourOutput colour = ParseColourOutput(ro.spectral.colour);
     const WhitePoint white = ParseWhitePoint(ro.spectral.white);
-    const BatchSeeds seeds = ParseBatchSeeds(ro.spectral.batch_seeds);
+    const SpectralBatching batching = ParseSpectralBatching(ro.spectral);
     const SpectralAtmosphere atmosphere = LoadSpectralAtmosphere(common.atmosphere, common.sets);
     const bool all_views = ro.view == "all";
     // Every view per batch: one Prepare per batch for all the views (in groups of
@@ -72,7 +72,7 @@ int RenderSpectralViews(const CommonOptions& common, const RenderOptions& ro,
         const std::vector<SpectralImage> spectra = RenderSpectralRequests(
             GivenModel(common), atmosphere, nm, group_requests,
             [&](const AtmosphereParameters& a, Model* model) { PrepareModel(common, a, model); },
-            nullptr, nullptr, seeds);
+            nullptr, nullptr, batching);
         const double seconds = Seconds(start);
         if (!common.quiet) {
             std::fprintf(stderr,

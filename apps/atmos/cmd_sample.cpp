@@ -215,8 +215,8 @@ int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const S
         ParseWavelengths(spectral.wavelengths);  // fail before reading stdin
         const MonteCarloSettings mc = flags.Settings(CreateModel(GivenModel(common))->Info());
         const bool npy = !io.output.empty() && io.output != "-" && IsNpyPath(io.output);
-        const BatchSeeds seeds = ParseBatchSeeds(spectral.batch_seeds);
-        return SampleSpectralCsv(common, mc, spectral.wavelengths, ReadQueries(io.input), seeds,
+        const SpectralBatching batching = ParseSpectralBatching(spectral);
+        return SampleSpectralCsv(common, mc, spectral.wavelengths, ReadQueries(io.input), batching,
                                  io.output, npy);
     }
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);

@@ -24,14 +24,14 @@ namespace atmos::cli {
 
 int SampleSpectralCsv(const CommonOptions& common, const MonteCarloSettings& monte_carlo,
                       const std::string& wavelengths, const std::vector<SampleQuery>& queries,
-                      BatchSeeds seeds, const std::string& output, bool npy) {
+                      SpectralBatching batching, const std::string& output, bool npy) {
     if (!common.load.empty()) Fail("--load cannot be combined with --wavelengths");
     const std::vector<double> nm = ParseWavelengths(wavelengths);
     const SpectralAtmosphere atmosphere = LoadSpectralAtmosphere(common.atmosphere, common.sets);
     const std::vector<double> values = SampleSpectral(
         GivenModel(common), atmosphere, nm, queries, monte_carlo,
         [&](const AtmosphereParameters& a, Model* model) { PrepareModel(common, a, model); },
-        seeds);
+        batching);
     const std::vector<double> weights = WavelengthWeights(nm);
     const size_t n = nm.size();
     if (npy) {

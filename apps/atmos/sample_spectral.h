@@ -15,7 +15,7 @@ namespace atmos::cli {
 // shape (queries, wavelengths + 3), the L_<nm> values then X, Y, Z per row.
 int SampleSpectralCsv(const CommonOptions& common, const MonteCarloSettings& monte_carlo,
                       const std::string& wavelengths, const std::vector<SampleQuery>& queries,
-                      BatchSeeds seeds = BatchSeeds::kSame, const std::string& output = "",
+                      SpectralBatching batching = {}, const std::string& output = "",
                       bool npy = false);
 
 }  // namespace atmos::cli

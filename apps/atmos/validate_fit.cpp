@@ -100,7 +100,8 @@ double KiderResidual(const AerosolFitSettings& settings, const std::string& atmo
     const SpectralAtmosphere a = LoadSpectralAtmosphere(atmosphere, sets);
     const std::vector<double> values = SampleSpectral(
         ParseModelSpec(settings.model), a, settings.nm, queries, settings.monte_carlo,
-        [](const AtmosphereParameters& p, Model* model) { model->Prepare(p); });
+        [](const AtmosphereParameters& p, Model* model) { model->Prepare(p); },
+        kPerWavelengthBatching);
     ErrorSum e;
     for (size_t q = 0; q < samples.size(); ++q) {
         for (size_t i = 0; i < settings.nm.size(); ++i) {

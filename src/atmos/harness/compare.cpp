@@ -158,7 +158,7 @@ class LazyRenderer {
                     m->Prepare(a);
                     prepare += SecondsSince(p0);
                 },
-                &render_seconds, &reports, config_.batch_seeds);
+                &render_seconds, &reports, config_.batching);
             prepare_seconds_ += prepare;
             prepared_ = true;
             for (size_t v = 0; v < group_views.size(); ++v) {

@@ -61,7 +61,7 @@ struct CompareConfig {
     std::vector<double> reference_wavelengths;
     SpectralAtmosphere spectral_atmosphere;
     WhitePoint white = WhitePoint::kD65;
-    BatchSeeds batch_seeds = BatchSeeds::kSame;  // a Monte Carlo model's batches
+    SpectralBatching batching;  // a spectral run's batches (layout, Monte Carlo seeds)
     std::string output_dir = "out";
     std::string cache_dir;  // empty: no cache
     FlipOptions flip;

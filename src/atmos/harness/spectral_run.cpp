@@ -2,6 +2,7 @@
 #include "harness/spectral_run.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -15,9 +16,13 @@ namespace atmos {
 
 namespace {
 
-// The three wavelengths of batch b (the last batch repeats its last wavelength).
-void BatchWavelengths(const std::vector<double>& nm, size_t b, double out[3]) {
-    for (size_t c = 0; c < 3; ++c) out[c] = nm[std::min(3 * b + c, nm.size() - 1)];
+// Channel c of a batch stores its wavelength unless an earlier channel holds the
+// same index (the repeats that fill a short batch).
+bool StoresChannel(const std::array<size_t, 3>& batch, size_t c) {
+    for (size_t k = 0; k < c; ++k) {
+        if (batch[k] == batch[c]) return false;
+    }
+    return true;
 }
 
 std::unique_ptr<Model> PrepareBatch(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
@@ -39,6 +44,27 @@ BatchSeeds ParseBatchSeeds(const std::string& text) {
     Fail("--batch-seeds '", text, "': expected same or distinct");
 }
 
+BatchLayout ParseBatchLayout(const std::string& text) {
+    if (text == "consecutive") return BatchLayout::kConsecutive;
+    if (text == "interleaved") return BatchLayout::kInterleaved;
+    Fail("--batch-layout '", text, "': expected consecutive or interleaved");
+}
+
+std::vector<std::array<size_t, 3>> SpectralBatches(size_t wavelengths, BatchLayout layout) {
+    std::vector<std::array<size_t, 3>> batches;
+    if (wavelengths == 0) return batches;
+    const size_t count = (wavelengths + 2) / 3;
+    for (size_t b = 0; b < count; ++b) {
+        std::array<size_t, 3> batch{};
+        for (size_t c = 0; c < 3; ++c) {
+            const size_t i = layout == BatchLayout::kConsecutive ? 3 * b + c : b + c * count;
+            batch[c] = i < wavelengths ? i : batch[c > 0 ? c - 1 : 0];
+        }
+        batches.push_back(batch);
+    }
+    return batches;
+}
+
 uint64_t BatchSeed(uint64_t seed, size_t batch, BatchSeeds seeds) {
     // CLI seeds are below 2^32 (halves: 2s + 2 < 2^34): b * 2^40 keeps them apart.
     return seeds == BatchSeeds::kSame ? seed : seed + (static_cast<uint64_t>(batch) << 40);
@@ -56,15 +82,17 @@ void RequireSpectralModel(const ModelInfo& info) {
 
 SpectralImage RenderSpectral(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
                              const std::vector<double>& nm, const RenderRequest& request,
-                             const PrepareFunction& prepare, BatchSeeds seeds) {
-    return RenderSpectralRequests(spec, atmosphere, nm, {request}, prepare, nullptr, nullptr, seeds)
+                             const PrepareFunction& prepare, SpectralBatching batching) {
+    return RenderSpectralRequests(spec, atmosphere, nm, {request}, prepare, nullptr, nullptr,
+                                  batching)
         .front();
 }
 
 std::vector<SpectralImage> RenderSpectralRequests(
     const ModelSpec& spec, const SpectralAtmosphere& atmosphere, const std::vector<double>& nm,
     const std::vector<RenderRequest>& requests, const PrepareFunction& prepare,
-    std::vector<double>* render_seconds, std::vector<MonteCarloReport>* reports, BatchSeeds seeds) {
+    std::vector<double>* render_seconds, std::vector<MonteCarloReport>* reports,
+    SpectralBatching batching) {
     const size_t n = nm.size();
     std::vector<SpectralImage> out(requests.size());
     for (size_t v = 0; v < requests.size(); ++v) {
@@ -75,9 +103,9 @@ std::vector<SpectralImage> RenderSpectralRequests(
     }
     if (render_seconds) render_seconds->assign(requests.size(), 0.0);
     if (reports) reports->assign(requests.size(), MonteCarloReport());
-    for (size_t b = 0; 3 * b < n; ++b) {
-        double l[3];
-        BatchWavelengths(nm, b, l);
+    const std::vector<std::array<size_t, 3>> batches = SpectralBatches(n, batching.layout);
+    for (size_t b = 0; b < batches.size(); ++b) {
+        const double l[3] = {nm[batches[b][0]], nm[batches[b][1]], nm[batches[b][2]]};
         AtmosphereParameters batch;
         std::unique_ptr<Model> model = PrepareBatch(spec, atmosphere, l, prepare, &batch);
         for (size_t v = 0; v < requests.size(); ++v) {
@@ -85,7 +113,7 @@ std::vector<SpectralImage> RenderSpectralRequests(
             r.checkpoint.clear();
             r.resume = false;
             r.variance = nullptr;
-            r.monte_carlo.seed = BatchSeed(r.monte_carlo.seed, b, seeds);
+            r.monte_carlo.seed = BatchSeed(r.monte_carlo.seed, b, batching.seeds);
             MonteCarloReport report;
             r.report = &report;
             Image image;
@@ -102,8 +130,10 @@ std::vector<SpectralImage> RenderSpectralRequests(
             }
             const size_t pixels = static_cast<size_t>(r.width) * r.height;
             for (size_t p = 0; p < pixels; ++p) {
-                for (size_t c = 0; c < 3 && 3 * b + c < n; ++c) {
-                    out[v].values[p * n + 3 * b + c] = image.data()[p * 3 + c];
+                for (size_t c = 0; c < 3; ++c) {
+                    if (StoresChannel(batches[b], c)) {
+                        out[v].values[p * n + batches[b][c]] = image.data()[p * 3 + c];
+                    }
                 }
             }
         }
@@ -132,23 +162,24 @@ std::vector<double> SampleSpectral(const ModelSpec& spec, const SpectralAtmosphe
                                    const std::vector<double>& nm,
                                    const std::vector<SampleQuery>& queries,
                                    const MonteCarloSettings& monte_carlo,
-                                   const PrepareFunction& prepare, BatchSeeds seeds) {
+                                   const PrepareFunction& prepare, SpectralBatching batching) {
     const size_t n = nm.size();
     std::vector<double> out(queries.size() * n, 0.0);
-    for (size_t b = 0; 3 * b < n; ++b) {
-        double l[3];
-        BatchWavelengths(nm, b, l);
+    const std::vector<std::array<size_t, 3>> batches = SpectralBatches(n, batching.layout);
+    for (size_t b = 0; b < batches.size(); ++b) {
+        const double l[3] = {nm[batches[b][0]], nm[batches[b][1]], nm[batches[b][2]]};
         AtmosphereParameters batch;
         std::unique_ptr<Model> model = PrepareBatch(spec, atmosphere, l, prepare, &batch);
         MonteCarloSettings mc = monte_carlo;
-        mc.seed = BatchSeed(mc.seed, b, seeds);
+        mc.seed = BatchSeed(mc.seed, b, batching.seeds);
         const std::vector<SampleAnswer> answers = model->Info().capabilities.stochastic
                                                       ? SampleMonteCarlo(*model, queries, mc)
                                                       : model->Sample(queries);
         for (size_t q = 0; q < queries.size(); ++q) {
-            for (size_t c = 0; c < 3 && 3 * b + c < n; ++c) {
+            for (size_t c = 0; c < 3; ++c) {
+                if (!StoresChannel(batches[b], c)) continue;
                 const int ci = static_cast<int>(c);
-                out[q * n + 3 * b + c] =
+                out[q * n + batches[b][c]] =
                     static_cast<double>(answers[q].radiance[ci]) * batch.solar_irradiance[ci];
             }
         }

@@ -1,13 +1,14 @@
 // atmos: spectral rendering and sampling (docs/architecture.md "Spectral rendering").
 //
 // The models compute three channels. A spectral run evaluates a SpectralAtmosphere
-// at the wavelengths in batches of three (the last batch repeats its last
-// wavelength), prepares a fresh model per batch and renders or samples it: the
-// models are unchanged, as in Bruneton 2017's precomputation of N wavelengths in
-// batches. Monte Carlo models use the same seed in every batch (their paths are
-// the same random numbers at every wavelength; no checkpoints or variance).
+// at the wavelengths in batches of three (SpectralBatches: neighbours by default;
+// a short batch repeats its last wavelength), prepares a fresh model per batch and renders or
+// samples it: the models are unchanged, as in Bruneton 2017's precomputation of N wavelengths in
+// batches. Monte Carlo models take a seed per batch (SpectralBatching; no
+// checkpoints or variance).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -37,6 +38,32 @@ enum class BatchSeeds { kSame, kDistinct };
 BatchSeeds ParseBatchSeeds(const std::string& text);  // "same" or "distinct"
 uint64_t BatchSeed(uint64_t seed, size_t batch, BatchSeeds seeds);
 
+// Which wavelengths share a batch. kConsecutive: batch b holds wavelengths 3b,
+// 3b+1, 3b+2 (neighbours, as Bruneton 2017 precomputes them). kInterleaved: batch
+// b holds b, b+S, b+2S with S = ceil(N/3): three wavelengths spread over the
+// range, the stratified companions of hero-wavelength sampling (Wilkie et al.
+// 2014, "Hero Wavelength Spectral Sampling"), with the hero swept over the
+// batches in turn instead of drawn per path. A deterministic model gives the
+// same values either way; for a Monte Carlo model with distinct seeds, the
+// wavelengths a colour-matching function spans fall in more independent batches.
+enum class BatchLayout { kConsecutive, kInterleaved };
+BatchLayout ParseBatchLayout(const std::string& text);  // "consecutive" or "interleaved"
+
+// The default: interleaved batches with distinct seeds, the least noise in colour
+// (luminance and chromaticity) at equal time of the four (docs/harness.md "Batch
+// layout and seeds", scripts/spectral_noise.py). kPerWavelength: consecutive
+// batches with one seed, the least noise in each wavelength's own value (what
+// validate scores).
+struct SpectralBatching {
+    BatchSeeds seeds = BatchSeeds::kDistinct;
+    BatchLayout layout = BatchLayout::kInterleaved;
+};
+constexpr SpectralBatching kPerWavelengthBatching{BatchSeeds::kSame, BatchLayout::kConsecutive};
+
+// The wavelength indices of each batch, ceil(N/3) batches of three; a batch short
+// of three repeats its last index (its extra channels are computed, not stored).
+std::vector<std::array<size_t, 3>> SpectralBatches(size_t wavelengths, BatchLayout layout);
+
 // Prepare()s a model for one batch's atmosphere (the CLI passes its PrepareModel).
 using PrepareFunction = std::function<void(const AtmosphereParameters&, Model*)>;
 
@@ -50,7 +77,7 @@ void RequireSpectralModel(const ModelInfo& info);
 // pixel's irradiance), in the solar spectrum's units per steradian.
 SpectralImage RenderSpectral(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
                              const std::vector<double>& nm, const RenderRequest& request,
-                             const PrepareFunction& prepare, BatchSeeds seeds = BatchSeeds::kSame);
+                             const PrepareFunction& prepare, SpectralBatching batching = {});
 
 // Renders every request (e.g. the views of a compare, any sizes) at each
 // wavelength: one Prepare per batch for all the requests (the batches outer, the
@@ -63,7 +90,7 @@ std::vector<SpectralImage> RenderSpectralRequests(
     const ModelSpec& spec, const SpectralAtmosphere& atmosphere, const std::vector<double>& nm,
     const std::vector<RenderRequest>& requests, const PrepareFunction& prepare,
     std::vector<double>* render_seconds = nullptr, std::vector<MonteCarloReport>* reports = nullptr,
-    BatchSeeds seeds = BatchSeeds::kSame);
+    SpectralBatching batching = {});
 
 // Groups of consecutive request indices whose spectral images (width x height x
 // wavelengths floats) take at most `max_bytes` together (a request alone may
@@ -79,8 +106,7 @@ std::vector<double> SampleSpectral(const ModelSpec& spec, const SpectralAtmosphe
                                    const std::vector<double>& nm,
                                    const std::vector<SampleQuery>& queries,
                                    const MonteCarloSettings& monte_carlo,
-                                   const PrepareFunction& prepare,
-                                   BatchSeeds seeds = BatchSeeds::kSame);
+                                   const PrepareFunction& prepare, SpectralBatching batching = {});
 
 enum class ColourOutput { kSrgb, kXyz };
 ColourOutput ParseColourOutput(const std::string& text);  // "srgb" or "xyz"
