@@ -29,12 +29,23 @@ float atmos_ClampCosine(float mu) { return clamp(mu, -1.0, 1.0); }
 float atmos_TextureCoord(float x, float n) { return 0.5 / n + x * (1.0 - 1.0 / n); }
 // RayleighPhase (physics/phase.h; seed 004 RayleighPhaseFunction).
 float atmos_RayleighPhase(float nu) { return 3.0 / (16.0 * ATMOS_PI) * (1.0 + nu * nu); }
-// CornetteShanksPhase (phase.h; seed 004 MiePhaseFunction) with g = ATMOS_MIE_PHASE_G.
-float atmos_MiePhase(float nu) {
-    float g = ATMOS_MIE_PHASE_G;
+// CornetteShanksPhase (phase.h; seed 004 MiePhaseFunction).
+float atmos_CornetteShanksPhase(float g, float nu) {
     float k = 3.0 / (8.0 * ATMOS_PI) * (1.0 - g * g) / (2.0 + g * g);
     float denom = 1.0 + g * g - 2.0 * g * nu;
     return k * (1.0 + nu * nu) / (denom * sqrt(denom));
+}
+// MiePhase (phase.h): CornetteShanksPhase with g = ATMOS_MIE_PHASE_G, or, when
+// the constants define ATMOS_MIE_PHASE_WEIGHT2 (an atmosphere with a second
+// lobe), (1 - w) CS(ATMOS_MIE_PHASE_G) + w CS(ATMOS_MIE_PHASE_G2).
+float atmos_MiePhase(float nu) {
+#ifdef ATMOS_MIE_PHASE_WEIGHT2
+    float w = ATMOS_MIE_PHASE_WEIGHT2;
+    return (1.0 - w) * atmos_CornetteShanksPhase(ATMOS_MIE_PHASE_G, nu) +
+           w * atmos_CornetteShanksPhase(ATMOS_MIE_PHASE_G2, nu);
+#else
+    return atmos_CornetteShanksPhase(ATMOS_MIE_PHASE_G, nu);
+#endif
 }
 // DistanceToTopAtmosphereBoundary (geometry.h; seed 004 "Distance to the top
 // atmosphere boundary"): discriminant r^2 (mu^2 - 1) + top^2.

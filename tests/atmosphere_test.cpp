@@ -53,6 +53,8 @@ std::vector<std::pair<std::string, double>> Flatten(const AtmosphereParameters& 
     rgb("mie_extinction", a.mie_extinction);
     profile("mie_density", a.mie_density);
     out.emplace_back("mie_phase_g", a.mie_phase_g);
+    out.emplace_back("mie_phase_g2", a.mie_phase_g2);
+    out.emplace_back("mie_phase_weight2", a.mie_phase_weight2);
     rgb("absorption_extinction", a.absorption_extinction);
     profile("absorption_density", a.absorption_density);
     rgb("ground_albedo", a.ground_albedo);
@@ -234,6 +236,57 @@ TEST(Atmosphere, JsonRoundTripIsExact) {
         EXPECT_TRUE(ChangedFields(a, b).empty()) << text;
         EXPECT_EQ(AtmosphereToJson(b), text);
     }
+}
+
+TEST(Atmosphere, SecondMieLobeRoundTripsAndIsValidated) {
+    // Written only with a weight (or a g2): one-lobe atmospheres keep their
+    // text (and the fingerprints made from it).
+    const std::string earth_text = AtmosphereToJson(EarthAtmosphere());
+    EXPECT_EQ(earth_text.find("mie_phase_g2"), std::string::npos) << earth_text;
+    EXPECT_EQ(earth_text.find("mie_phase_weight2"), std::string::npos) << earth_text;
+    for (const std::string& name : AtmospherePresetNames()) {
+        if (name == "kider-2013-aeronet") continue;
+        EXPECT_EQ(AtmosphereToJson(LoadAtmosphere(name)).find("mie_phase_weight2"),
+                  std::string::npos)
+            << name;
+    }
+    AtmosphereParameters a = EarthAtmosphere();
+    a.mie_phase_g = 0.55;
+    a.mie_phase_g2 = 0.94;
+    a.mie_phase_weight2 = 0.1;
+    const std::string text = AtmosphereToJson(a);
+    EXPECT_NE(text.find("\"mie_phase_g2\": 0.94"), std::string::npos) << text;
+    EXPECT_NE(text.find("\"mie_phase_weight2\": 0.1"), std::string::npos) << text;
+    const AtmosphereParameters b = AtmosphereFromJson(text, "two lobes");
+    EXPECT_TRUE(ChangedFields(a, b).empty()) << text;
+    EXPECT_EQ(AtmosphereToJson(b), text);
+
+    // --set reaches the two fields (absent from the file).
+    const AtmosphereParameters c =
+        LoadAtmosphere("earth", {"mie_phase_g2=0.9", "mie_phase_weight2=0.25"});
+    EXPECT_EQ(ChangedFields(EarthAtmosphere(), c),
+              (std::vector<std::string>{"mie_phase_g2", "mie_phase_weight2"}));
+    EXPECT_EQ(c.mie_phase_g2, 0.9);
+    EXPECT_EQ(c.mie_phase_weight2, 0.25);
+
+    // The preset: kider-2013 with the AERONET-informed aerosol.
+    const AtmosphereParameters k = LoadAtmosphere("kider-2013-aeronet");
+    EXPECT_EQ(k.mie_phase_g, 0.55);
+    EXPECT_EQ(k.mie_phase_g2, 0.94);
+    EXPECT_EQ(k.mie_phase_weight2, 0.1);
+
+    // Bad values name the field.
+    EXPECT_ERROR_CONTAINS(LoadAtmosphere("earth", {"mie_phase_weight2=1.5"}),
+                          "'mie_phase_weight2': 1.5 is outside the allowed range [0, 1]");
+    EXPECT_ERROR_CONTAINS(LoadAtmosphere("earth", {"mie_phase_weight2=-0.1"}),
+                          "'mie_phase_weight2'");
+    EXPECT_ERROR_CONTAINS(LoadAtmosphere("earth", {"mie_phase_g2=1"}),
+                          "'mie_phase_g2': 1 is outside the allowed range (-1, 1)");
+    EXPECT_ERROR_CONTAINS(LoadAtmosphere("earth", {"mie_phase_g2=-1"}), "'mie_phase_g2'");
+    std::string typed = text;
+    typed.replace(typed.find("\"mie_phase_weight2\": 0.1"), 24, "\"mie_phase_weight2\": \"a\"");
+    EXPECT_ERROR_CONTAINS(AtmosphereFromJson(typed, "typed"),
+                          "field 'mie_phase_weight2' must be a number");
 }
 
 TEST(Atmosphere, LoadsAFileByPath) {

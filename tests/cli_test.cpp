@@ -862,6 +862,32 @@ TEST(Cli, ValidateFitsTheAerosol) {
         "not a Kider bin");
 }
 
+// --fit-second-lobe also fits the second Cornette-Shanks lobe (six parameters),
+// from kider-2013-aeronet's own lobe.
+TEST(Cli, ValidateFitsTheSecondMieLobe) {
+#ifndef ATMOS_HAVE_NLOPT
+    GTEST_SKIP() << "built without NLopt";
+#endif
+    const fs::path data = fs::path(ATMOS_SOURCE_DIR) / "tests" / "data" / "kider-2013";
+    const Result r = RunAtmos(
+        "validate kider-2013 -q -a kider-2013-aeronet --models naive --fit --fit-model naive "
+        "--fit-second-lobe --fit-evaluations 14 --data " +
+        data.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("  g2      "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("(start 0.94, bounds [0.5, 0.98])"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("(start 0.1, bounds [0, 0.5])"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--set mie_phase_g2="), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--set mie_phase_weight2="), std::string::npos) << r.err;
+    double after = 0.0, before = 0.0;
+    const size_t at = r.err.find("relative RMSE ");
+    ASSERT_NE(at, std::string::npos) << r.err;
+    ASSERT_EQ(
+        std::sscanf(r.err.c_str() + at, "relative RMSE %lf %% (start %lf %%)", &after, &before), 2)
+        << r.err;
+    EXPECT_LE(after, before) << r.err;
+}
+
 // Issue 17: compare --wavelengths compares the spectral renders as linear sRGB.
 TEST(Cli, CompareWavelengths) {
     const fs::path out = TempDir() / "compare_spectral";

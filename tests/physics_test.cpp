@@ -1,12 +1,14 @@
 // Tests of the physics core against closed forms and independent integrals.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "atmos/atmosphere.h"
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
+#include "physics/sampling.h"
 #include "physics/transmittance.h"
 
 namespace atmos {
@@ -138,6 +140,70 @@ TEST(Phase, EachIntegratesToOne) {
         EXPECT_NEAR(SphereIntegral([g](double nu) { return CornetteShanksPhase(g, nu); }), 1.0,
                     1e-6)
             << g;
+    }
+}
+
+// An atmosphere whose only use here is its Mie phase: lobes g and g2, weight w.
+AtmosphereParameters TwoLobes(double g, double g2, double w) {
+    AtmosphereParameters a = EarthAtmosphere();
+    a.mie_phase_g = g;
+    a.mie_phase_g2 = g2;
+    a.mie_phase_weight2 = w;
+    return a;
+}
+
+TEST(Phase, TwoLobeMieIntegratesToOneAndIsOneLobeAtWeightZero) {
+    for (double w : {0.0, 0.3, 1.0}) {
+        const double lobes[2][2] = {{0.55, 0.94}, {0.8, -0.3}};
+        for (const auto& lobe : lobes) {
+            const AtmosphereParameters a = TwoLobes(lobe[0], lobe[1], w);
+            EXPECT_NEAR(SphereIntegral([&a](double nu) { return MiePhase(a, nu); }), 1.0, 1e-6)
+                << w << " " << lobe[1];
+        }
+    }
+    // w = 0: exactly the one lobe (bit for bit), whatever g2; w = 1: exactly lobe 2's.
+    for (double nu : {-1.0, -0.3, 0.0, 0.5, 0.99, 1.0}) {
+        EXPECT_EQ(MiePhase(TwoLobes(0.7, 0.94, 0.0), nu), CornetteShanksPhase(0.7, nu)) << nu;
+        EXPECT_EQ(MiePhase(TwoLobes(0.7, 0.0, 0.0), nu), CornetteShanksPhase(0.7, nu)) << nu;
+        EXPECT_EQ(MiePhase(TwoLobes(0.7, 0.94, 1.0), nu), CornetteShanksPhase(0.94, nu)) << nu;
+        EXPECT_NEAR(MiePhase(TwoLobes(0.55, 0.94, 0.1), nu),
+                    0.9 * CornetteShanksPhase(0.55, nu) + 0.1 * CornetteShanksPhase(0.94, nu),
+                    1e-14 * CornetteShanksPhase(0.94, nu));
+    }
+}
+
+TEST(Sampling, TwoLobeMieSamplingIsUnbiasedAndBounded) {
+    // E[f(mu) P(mu) / pdf(mu)] over SampleMiePhaseCosine's directions (1e6
+    // stratified uniform numbers: the mean is a quadrature in xi) equals the
+    // integral of P f over the sphere (2e5 midpoints in mu), for f = 1 and
+    // a forward-peaked f; the weight P / pdf stays below 1.5 (the larger of
+    // the lobes' CS/HG ratios).
+    auto forward = [](double mu) { return std::exp(8.0 * (mu - 1.0)); };
+    for (double w : {0.0, 0.1, 0.5, 1.0}) {
+        const AtmosphereParameters a = TwoLobes(0.55, 0.94, w);
+        const int n = 1000000;
+        double sum_one = 0.0, sum_forward = 0.0, max_weight = 0.0;
+        for (int i = 0; i < n; ++i) {
+            const double mu = SampleMiePhaseCosine(a, (i + 0.5) / n);
+            const double weight = MiePhaseOverSamplingPdf(a, mu);
+            EXPECT_NEAR(weight, MiePhase(a, mu) / MiePhaseSamplingPdf(a, mu), 1e-12 * weight);
+            max_weight = std::max(max_weight, weight);
+            sum_one += weight;
+            sum_forward += weight * forward(mu);
+        }
+        const double want =
+            SphereIntegral([&](double mu) { return MiePhase(a, mu) * forward(mu); });
+        EXPECT_NEAR(sum_one / n, 1.0, 2e-4) << w;
+        EXPECT_NEAR(sum_forward / n, want, 2e-4 * want) << w;
+        EXPECT_LE(max_weight, 1.5) << w;
+    }
+    // w = 0 draws exactly as Henyey-Greenstein g alone, with its weight.
+    const AtmosphereParameters one = TwoLobes(0.7, 0.94, 0.0);
+    for (double xi : {0.0, 0.1, 0.5, 0.93}) {
+        const double mu = SampleMiePhaseCosine(one, xi);
+        EXPECT_EQ(mu, SampleHenyeyGreensteinCosine(0.7, xi));
+        EXPECT_EQ(MiePhaseOverSamplingPdf(one, mu), CornetteShanksOverHenyeyGreenstein(0.7, mu));
+        EXPECT_EQ(MiePhaseSamplingPdf(one, mu), HenyeyGreensteinPhase(0.7, mu));
     }
 }
 

@@ -85,7 +85,9 @@ struct BrowserImage {
     atmos::Image image;
 };
 
-TEST(Viewer, WebGlRenderingOfTheBakedTablesMatchesAtmosRender) {
+// The comparison above for the earth atmosphere with the `--set` flags `sets`
+// (empty, or ones that give it a second Mie lobe).
+void ExpectBrowserMatchesAtmosRender(const std::string& sets) {
 #if defined(__SANITIZE_ADDRESS__)
     GTEST_SKIP()
         << "not under sanitizers (it runs the CLI and a browser; the Release suite has it)";
@@ -116,9 +118,10 @@ TEST(Viewer, WebGlRenderingOfTheBakedTablesMatchesAtmosRender) {
         "transmittance-width=16:transmittance-height=64:gather-theta=6:gather-phi=12";
     const std::map<std::string, std::string> models = {
         {"bruneton", bruneton}, {"hillaire", "hillaire"}, {"atmosphere-plus", aplus}};
-    ASSERT_EQ(System(cli + " viewer --models " + bruneton + ",hillaire," + aplus + " -o " +
-                     page.string() + " --quiet > " + (dir / "viewer.log").string() + " 2>&1"),
-              0)
+    ASSERT_EQ(
+        System(cli + " viewer" + sets + " --models " + bruneton + ",hillaire," + aplus + " -o " +
+               page.string() + " --quiet > " + (dir / "viewer.log").string() + " 2>&1"),
+        0)
         << Slurp(dir / "viewer.log");
     for (const char* shader :
          {"bruneton/shaders/bruneton.glsl", "hillaire/shaders/hillaire.glsl",
@@ -175,9 +178,9 @@ TEST(Viewer, WebGlRenderingOfTheBakedTablesMatchesAtmosRender) {
     // The library from the same tables.
     const fs::path renders = dir / "render";
     for (const auto& [name, spec] : models) {
-        ASSERT_EQ(System(cli + " render --model " + spec + " --load " + (page / name).string() +
-                         " --view all --size " + std::to_string(width) + "x" +
-                         std::to_string(height) + " --quiet -o " + renders.string() + " > " +
+        ASSERT_EQ(System(cli + " render" + sets + " --model " + spec + " --load " +
+                         (page / name).string() + " --view all --size " + std::to_string(width) +
+                         "x" + std::to_string(height) + " --quiet -o " + renders.string() + " > " +
                          (dir / "render.log").string() + " 2>&1"),
                   0)
             << Slurp(dir / "render.log");
@@ -193,6 +196,16 @@ TEST(Viewer, WebGlRenderingOfTheBakedTablesMatchesAtmosRender) {
         EXPECT_LE(flip.mean, 0.01) << b.model << " " << b.view;
     }
     fs::remove_all(dir);
+}
+
+TEST(Viewer, WebGlRenderingOfTheBakedTablesMatchesAtmosRender) {
+    ExpectBrowserMatchesAtmosRender("");
+}
+
+TEST(Viewer, WebGlRenderingMatchesAtmosRenderWithTwoMieLobes) {
+    // The shaders' second lobe (ATMOS_MIE_PHASE_G2, ATMOS_MIE_PHASE_WEIGHT2 in
+    // the baked constants) against the library's MiePhase.
+    ExpectBrowserMatchesAtmosRender(" --set mie_phase_g2=0.95 --set mie_phase_weight2=0.3");
 }
 
 }  // namespace

@@ -52,6 +52,7 @@ struct ValidateOptions {
     std::string fit_wavelengths = "371.75,418.75,465.75,512.75,559.75,606.75,653.75,700.75,794.75";
     std::string fit_captures;  // empty: those of --captures
     int fit_evaluations = 40;
+    bool fit_second_lobe = false;
 };
 
 std::vector<std::string> SplitList(const std::string& text) {
@@ -179,6 +180,7 @@ int CmdValidate(const ValidateOptions& o) {
         settings.monte_carlo = MakeMonteCarloSettings(o.spp, o.seed, 0, "--spp");
         settings.nm = ParseWavelengths(o.fit_wavelengths);
         settings.max_evaluations = o.fit_evaluations;
+        settings.second_lobe = o.fit_second_lobe;
         settings.quiet = o.quiet;
         const std::vector<std::string> fit_wanted =
             o.fit_captures.empty() ? wanted : SplitList(o.fit_captures);
@@ -204,7 +206,7 @@ int CmdValidate(const ValidateOptions& o) {
                      o.fit_model.c_str(), fit_samples.size(), settings.nm.size(), fit.evaluations,
                      Seconds(start), fit.stop.c_str(), 100.0 * fit.residual,
                      100.0 * fit.start_residual);
-        for (int i = 0; i < 4; ++i) {
+        for (int i = 0; i < fit.count; ++i) {
             std::fprintf(stderr, "  %-7s %.6g (start %.6g, bounds [%g, %g])\n",
                          kAerosolParameters[i].name, fit.values[i], fit.start_values[i],
                          kAerosolParameters[i].lower, kAerosolParameters[i].upper);
@@ -383,6 +385,9 @@ Command AddValidateCommand(CLI::App* root) {
         ->add_option("--fit-evaluations", o->fit_evaluations,
                      "--fit: the most model evaluations of the optimiser")
         ->capture_default_str();
+    c.app->add_flag("--fit-second-lobe", o->fit_second_lobe,
+                    "--fit: also fit the second Cornette-Shanks lobe (mie_phase_g2 in [0.5, 0.98], "
+                    "mie_phase_weight2 in [0, 0.5])");
     c.app->add_option("--threads", o->threads, "worker threads (0: all cores)");
     c.app->add_flag("--quiet,-q", o->quiet, "no summary on stderr");
     c.run = [o] { return CmdValidate(*o); };

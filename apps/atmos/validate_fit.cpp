@@ -26,9 +26,10 @@ std::string SetText(const char* field, double value) {
     return buf;
 }
 
-std::vector<std::string> WithAerosol(const std::vector<std::string>& sets, const double x[4]) {
+std::vector<std::string> WithAerosol(const std::vector<std::string>& sets, const double* x,
+                                     int count) {
     std::vector<std::string> out = sets;
-    for (int i = 0; i < 4; ++i) out.push_back(SetText(kAerosolParameters[i].field, x[i]));
+    for (int i = 0; i < count; ++i) out.push_back(SetText(kAerosolParameters[i].field, x[i]));
     return out;
 }
 
@@ -46,13 +47,12 @@ struct Objective {
 };
 
 double ObjectiveFunction(unsigned n, const double* x, double* gradient, void* data) {
-    (void)n;
     (void)gradient;  // BOBYQA is derivative-free
     Objective& o = *static_cast<Objective*>(data);
     double r = 0.0;
     try {
-        r = KiderResidual(*o.settings, *o.atmosphere, WithAerosol(*o.sets, x), *o.samples,
-                          *o.queries);
+        r = KiderResidual(*o.settings, *o.atmosphere, WithAerosol(*o.sets, x, static_cast<int>(n)),
+                          *o.samples, *o.queries);
     } catch (const std::exception& e) {
         o.error = e.what();
         nlopt_force_stop(o.opt);
@@ -61,9 +61,14 @@ double ObjectiveFunction(unsigned n, const double* x, double* gradient, void* da
     ++o.evaluations;
     o.best = std::min(o.best, r);
     if (!o.settings->quiet) {
+        char lobe[64] = "";
+        if (n > kAerosolBaseParameters) {
+            std::snprintf(lobe, sizeof lobe, " g2 %.4f weight2 %.4f", x[4], x[5]);
+        }
         std::fprintf(stderr,
-                     "fit %3d: beta %.5f alpha %.4f albedo %.4f g %.4f -> %.3f %% (best %.3f %%)\n",
-                     o.evaluations, x[0], x[1], x[2], x[3], 100.0 * r, 100.0 * o.best);
+                     "fit %3d: beta %.5f alpha %.4f albedo %.4f g %.4f%s -> %.3f %% (best %.3f "
+                     "%%)\n",
+                     o.evaluations, x[0], x[1], x[2], x[3], lobe, 100.0 * r, 100.0 * o.best);
     }
     return r * r;  // the mean squared error over mean measured^2: least squares
 }
@@ -121,6 +126,8 @@ AerosolFit FitAerosol(const AerosolFitSettings& settings, const std::string& atm
     }
     if (settings.max_evaluations < 1) Fail("--fit-evaluations must be at least 1");
     AerosolFit fit;
+    fit.count = settings.second_lobe ? kAerosolMaxParameters : kAerosolBaseParameters;
+    const int n = fit.count;
     // The start: the atmosphere's own values, read off its spectra (beta = the
     // Mie extinction at 1 um times the Mie scale height, alpha from 500 and
     // 1000 nm, the albedo at 550 nm).
@@ -137,13 +144,15 @@ AerosolFit FitAerosol(const AerosolFitSettings& settings, const std::string& atm
         fit.start_values[1] = std::log(e500 / e1000) / std::log(2.0);
         fit.start_values[2] = a.mie_scattering.At(550.0) / a.mie_extinction.At(550.0);
         fit.start_values[3] = a.base.mie_phase_g;
-        for (int i = 0; i < 4; ++i) {
+        fit.start_values[4] = a.base.mie_phase_g2;
+        fit.start_values[5] = a.base.mie_phase_weight2;
+        for (int i = 0; i < n; ++i) {
             fit.start_values[i] = std::clamp(fit.start_values[i], kAerosolParameters[i].lower,
                                              kAerosolParameters[i].upper);
         }
     }
     // The --set paths need the Angstrom and albedo forms: one clear error if not.
-    LoadSpectralAtmosphere(atmosphere, WithAerosol(sets, fit.start_values));
+    LoadSpectralAtmosphere(atmosphere, WithAerosol(sets, fit.start_values, n));
 #ifdef ATMOS_HAVE_NLOPT
     Objective objective;
     objective.settings = &settings;
@@ -151,12 +160,13 @@ AerosolFit FitAerosol(const AerosolFitSettings& settings, const std::string& atm
     objective.sets = &sets;
     objective.samples = &samples;
     objective.queries = &queries;
-    fit.start_residual =
-        KiderResidual(settings, atmosphere, WithAerosol(sets, fit.start_values), samples, queries);
-    nlopt_opt opt = nlopt_create(NLOPT_LN_BOBYQA, 4);
+    fit.start_residual = KiderResidual(settings, atmosphere, WithAerosol(sets, fit.start_values, n),
+                                       samples, queries);
+    nlopt_opt opt = nlopt_create(NLOPT_LN_BOBYQA, static_cast<unsigned>(n));
     objective.opt = opt;
-    double lower[4], upper[4], step[4], x[4];
-    for (int i = 0; i < 4; ++i) {
+    double lower[kAerosolMaxParameters], upper[kAerosolMaxParameters], step[kAerosolMaxParameters],
+        x[kAerosolMaxParameters];
+    for (int i = 0; i < n; ++i) {
         lower[i] = kAerosolParameters[i].lower;
         upper[i] = kAerosolParameters[i].upper;
         step[i] = kAerosolParameters[i].step;
@@ -176,11 +186,11 @@ AerosolFit FitAerosol(const AerosolFitSettings& settings, const std::string& atm
     if (result < 0 && result != NLOPT_ROUNDOFF_LIMITED) {
         Fail("--fit: the optimiser failed (NLopt code ", static_cast<int>(result), ")");
     }
-    for (int i = 0; i < 4; ++i) fit.values[i] = x[i];
+    for (int i = 0; i < n; ++i) fit.values[i] = x[i];
     fit.residual = std::sqrt(value);
     fit.evaluations = objective.evaluations + 1;  // + the start's
     fit.stop = StopReason(result);
-    fit.sets = WithAerosol(sets, fit.values);
+    fit.sets = WithAerosol(sets, fit.values, n);
     return fit;
 #else
     (void)queries;

@@ -11,17 +11,22 @@
 
 namespace atmos::cli {
 
-// The four parameters, their bounds and the --set field each one writes.
+// The parameters, their bounds and the --set field each one writes: the four
+// of every fit, then the second Mie lobe's two (--fit-second-lobe).
 struct AerosolParameter {
     const char* field;  // e.g. "mie_extinction.angstrom.beta"
     const char* name;   // e.g. "beta"
     double lower, upper, step;
 };
-constexpr AerosolParameter kAerosolParameters[4] = {
+constexpr int kAerosolBaseParameters = 4;
+constexpr int kAerosolMaxParameters = 6;
+constexpr AerosolParameter kAerosolParameters[kAerosolMaxParameters] = {
     {"mie_extinction.angstrom.beta", "beta", 0.005, 0.3, 0.01},
     {"mie_extinction.angstrom.alpha", "alpha", 0.0, 2.5, 0.2},
     {"mie_scattering.single_scattering_albedo", "albedo", 0.5, 1.0, 0.05},
     {"mie_phase_g", "g", 0.0, 0.95, 0.05},
+    {"mie_phase_g2", "g2", 0.5, 0.98, 0.02},
+    {"mie_phase_weight2", "weight2", 0.0, 0.5, 0.05},
 };
 
 struct AerosolFitSettings {
@@ -29,17 +34,19 @@ struct AerosolFitSettings {
     MonteCarloSettings monte_carlo;
     std::vector<double> nm;  // Kider bins (nm) the fit compares
     int max_evaluations = 40;
+    bool second_lobe = false;  // also fit mie_phase_g2 and mie_phase_weight2
     bool quiet = false;
 };
 
 struct AerosolFit {
-    double values[4] = {};  // kAerosolParameters order
-    double start_values[4] = {};
+    int count = kAerosolBaseParameters;  // the parameters fitted (4, or 6 with the second lobe)
+    double values[kAerosolMaxParameters] = {};  // kAerosolParameters order
+    double start_values[kAerosolMaxParameters] = {};
     double residual = 0.0;        // relative RMSE (RMSE / mean measured) on the fit's set
     double start_residual = 0.0;  // the same with the atmosphere as given
     int evaluations = 0;
     std::string stop;  // why the optimiser stopped
-    // `sets` plus the four fitted --set overrides (FIELD=VALUE, %.6g).
+    // `sets` plus the fitted --set overrides (FIELD=VALUE, %.6g).
     std::vector<std::string> sets;
 };
 
@@ -50,8 +57,8 @@ double KiderResidual(const AerosolFitSettings& settings, const std::string& atmo
                      const std::vector<SampleQuery>& queries);
 
 // Bounded least squares (NLopt's BOBYQA, derivative-free) of the four parameters
-// from the atmosphere's own values. Throws atmos::Error when the atmosphere has no
-// Angstrom aerosol or the build has no NLopt.
+// (six with settings.second_lobe) from the atmosphere's own values. Throws atmos::Error when the
+// atmosphere has no Angstrom aerosol or the build has no NLopt.
 AerosolFit FitAerosol(const AerosolFitSettings& settings, const std::string& atmosphere,
                       const std::vector<std::string>& sets, const std::vector<KiderSample>& samples,
                       const std::vector<SampleQuery>& queries);

@@ -42,8 +42,13 @@ struct AtmosphereParameters {
     Vec3d mie_scattering;  // 1/m at density 1
     Vec3d mie_extinction;  // 1/m at density 1 (>= mie_scattering)
     DensityProfile mie_density;
-    double mie_phase_g = 0.8;     // Cornette-Shanks asymmetry
-    Vec3d absorption_extinction;  // 1/m at density 1 (ozone: absorption only)
+    double mie_phase_g = 0.8;  // Cornette-Shanks asymmetry
+    // An optional second Cornette-Shanks lobe: the Mie phase function is
+    // (1 - w) CS(mie_phase_g) + w CS(mie_phase_g2) with w = mie_phase_weight2
+    // (physics/phase.h MiePhase); w = 0 (the default) is the single lobe.
+    double mie_phase_g2 = 0.0;       // Cornette-Shanks asymmetry of the second lobe
+    double mie_phase_weight2 = 0.0;  // the second lobe's weight w, [0, 1]
+    Vec3d absorption_extinction;     // 1/m at density 1 (ozone: absorption only)
     DensityProfile absorption_density;
     Vec3d ground_albedo;                    // Lambertian, [0, 1]
     double sun_angular_radius = 0.004675;   // rad

@@ -80,6 +80,11 @@ def thread_count():
     return _atmos.thread_count()
 
 
+# Fields the JSON text leaves out at their default (the second Mie lobe,
+# written only when it has a weight): read as attributes, settable by replace().
+_OPTIONAL_FIELDS = {"mie_phase_g2": 0.0, "mie_phase_weight2": 0.0}
+
+
 class Atmosphere:
     """A validated atmosphere (SI units, the fields of data/atmospheres/*.json).
 
@@ -131,7 +136,7 @@ class Atmosphere:
         the field)."""
         d = self.to_dict()
         for k, v in fields.items():
-            if k not in d:
+            if k not in d and k not in _OPTIONAL_FIELDS:
                 raise ValueError(f"unknown atmosphere field '{k}' (fields: {', '.join(d)})")
             _check_finite(k, v)
             d[k] = _plain(v)
@@ -139,6 +144,8 @@ class Atmosphere:
 
     def __getattr__(self, name):
         fields = object.__getattribute__(self, "_fields")
+        if name not in fields and name in _OPTIONAL_FIELDS:
+            return _OPTIONAL_FIELDS[name]
         if name in fields:
             v = fields[name]
             if isinstance(v, list):

@@ -90,6 +90,14 @@ def test_atmosphere_load_fields_and_validation(tmp):
     g = earth.replace(mie_phase_g=np.float64(0.7))
     assert g.mie_phase_g == 0.7 and earth.mie_phase_g != 0.7
     assert atmos.Atmosphere.load("earth", ["mie_phase_g=0.7"]) == g
+    # The second Mie lobe: absent from one-lobe JSON, read as 0, settable.
+    assert "mie_phase_weight2" not in earth.to_dict()
+    assert earth.mie_phase_weight2 == 0.0 and earth.mie_phase_g2 == 0.0
+    two = earth.replace(mie_phase_g2=0.9, mie_phase_weight2=0.25)
+    assert two.mie_phase_g2 == 0.9 and two.mie_phase_weight2 == 0.25
+    assert atmos.Atmosphere.load("earth", ["mie_phase_g2=0.9", "mie_phase_weight2=0.25"]) == two
+    with pytest.raises(ValueError, match="mie_phase_weight2"):
+        earth.replace(mie_phase_weight2=1.5)
 
 
 # ---- sample: bit for bit with `atmos sample` -------------------------------------------------

@@ -10,7 +10,8 @@
 //       profile's layers[0] then has width 0 and never applies);
 //   {"scale_height": H}                      exp(-h / H);
 //   {"tent": {"center": c, "half_width": w}} 1 at c, falling linearly to 0 at c -/+ w.
-// Every field is required except mu_s_min (default cos(102 deg), seed 004's demo).
+// Every field is required except mu_s_min (default cos(102 deg), seed 004's demo)
+// and the second Mie lobe's mie_phase_g2 and mie_phase_weight2 (default 0: one lobe).
 // Unknown keys are errors (they are usually typos).
 #include <algorithm>
 #include <charconv>
@@ -47,6 +48,7 @@ constexpr FieldSpec kFields[] = {
     {"rayleigh_scattering", FieldKind::kRgb},   {"rayleigh_density", FieldKind::kDensity},
     {"mie_scattering", FieldKind::kRgb},        {"mie_extinction", FieldKind::kRgb},
     {"mie_density", FieldKind::kDensity},       {"mie_phase_g", FieldKind::kScalar},
+    {"mie_phase_g2", FieldKind::kScalar},       {"mie_phase_weight2", FieldKind::kScalar},
     {"absorption_extinction", FieldKind::kRgb}, {"absorption_density", FieldKind::kDensity},
     {"ground_albedo", FieldKind::kRgb},         {"sun_angular_radius", FieldKind::kScalar},
     {"solar_irradiance", FieldKind::kRgb},      {"mu_s_min", FieldKind::kScalar},
@@ -61,6 +63,12 @@ const char kDensityForms[] =
 
 // Seed 004's demo: max_sun_zenith_angle = 102 degrees.
 double DefaultMuSMin() { return std::cos(102.0 / 180.0 * kPi); }
+
+// The fields a file may leave out: mu_s_min (DefaultMuSMin) and the second
+// Mie lobe (weight 0: one lobe).
+bool IsOptionalField(const std::string& name) {
+    return name == "mu_s_min" || name == "mie_phase_g2" || name == "mie_phase_weight2";
+}
 
 const FieldSpec* FindField(const std::string& name) {
     for (const FieldSpec& spec : kFields) {
@@ -458,7 +466,7 @@ AtmosphereParameters ReadTree(const Json& root, const std::string& where) {
         }
     }
     for (const FieldSpec& spec : kFields) {
-        if (!root.contains(spec.name) && std::string(spec.name) != "mu_s_min") {
+        if (!root.contains(spec.name) && !IsOptionalField(spec.name)) {
             Fail(where, ": field '", spec.name, "' is missing");
         }
     }
@@ -472,6 +480,12 @@ AtmosphereParameters ReadTree(const Json& root, const std::string& where) {
     a.mie_extinction = ReadRgb(root["mie_extinction"], where, "mie_extinction");
     a.mie_density = ReadDensity(root["mie_density"], where, "mie_density");
     a.mie_phase_g = ReadNumber(root["mie_phase_g"], where, "mie_phase_g");
+    if (root.contains("mie_phase_g2")) {
+        a.mie_phase_g2 = ReadNumber(root["mie_phase_g2"], where, "mie_phase_g2");
+    }
+    if (root.contains("mie_phase_weight2")) {
+        a.mie_phase_weight2 = ReadNumber(root["mie_phase_weight2"], where, "mie_phase_weight2");
+    }
     a.absorption_extinction =
         ReadRgb(root["absorption_extinction"], where, "absorption_extinction");
     a.absorption_density = ReadDensity(root["absorption_density"], where, "absorption_density");
@@ -722,6 +736,12 @@ std::string AtmosphereToJson(const AtmosphereParameters& a) {
     root["mie_extinction"] = RgbToJson(a.mie_extinction);
     root["mie_density"] = DensityToJson(a.mie_density);
     root["mie_phase_g"] = a.mie_phase_g;
+    // The second lobe only when there is one, so that one-lobe atmospheres
+    // (every preset but kider-2013-aeronet) keep their text and fingerprints.
+    if (a.mie_phase_weight2 != 0.0 || a.mie_phase_g2 != 0.0) {
+        root["mie_phase_g2"] = a.mie_phase_g2;
+        root["mie_phase_weight2"] = a.mie_phase_weight2;
+    }
     root["absorption_extinction"] = RgbToJson(a.absorption_extinction);
     root["absorption_density"] = DensityToJson(a.absorption_density);
     root["ground_albedo"] = RgbToJson(a.ground_albedo);

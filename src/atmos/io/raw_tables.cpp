@@ -127,6 +127,12 @@ void WriteGlslAtmosphere(std::ostream& s, const AtmosphereParameters& a) {
     s << "#define ATMOS_BOTTOM_RADIUS " << a.bottom_radius << "\n";
     s << "#define ATMOS_TOP_RADIUS " << a.top_radius << "\n";
     s << "#define ATMOS_MIE_PHASE_G " << a.mie_phase_g << "\n";
+    if (a.mie_phase_weight2 != 0.0) {
+        // The second Cornette-Shanks lobe (common.glsl atmos_MiePhase); absent
+        // for one lobe, so one-lobe constants are as before.
+        s << "#define ATMOS_MIE_PHASE_G2 " << a.mie_phase_g2 << "\n";
+        s << "#define ATMOS_MIE_PHASE_WEIGHT2 " << a.mie_phase_weight2 << "\n";
+    }
     s << "#define ATMOS_SUN_ANGULAR_RADIUS " << a.sun_angular_radius << "\n";
     vec3("ATMOS_RAYLEIGH_SCATTERING", a.rayleigh_scattering);
     vec3("ATMOS_MIE_SCATTERING", a.mie_scattering);

@@ -77,6 +77,10 @@ ATMOS_HD inline double AplusModifiedRayleighPhase(double nu) {
 ATMOS_HD inline double AplusMiePhase(double g, double nu) {
     return 4.0 * kPi * CornetteShanksPhase(g, nu);  // seed 000 1.7 = 4 pi x seed 003 Eq. 5
 }
+// The atmosphere's Mie phase (one or two lobes, MiePhase) on the same scale.
+ATMOS_HD inline double AplusMiePhase(const AtmosphereParameters& atm, double nu) {
+    return 4.0 * kPi * MiePhase(atm, nu);
+}
 
 // The Mie channel stored in alpha (see the header's deviations).
 constexpr int kAplusMieChannel = 1;
@@ -371,7 +375,7 @@ struct AtmospherePlusEvaluator {
         // L = -sun and so dot(L, -V) = dot(sun, V) = nu.
         const double f_r =
             modified_rayleigh ? AplusModifiedRayleighPhase(nu) : AplusRayleighPhase(nu);
-        const double f_m = AplusMiePhase(atm.mie_phase_g, nu);
+        const double f_m = AplusMiePhase(atm, nu);
         const Rgb sky = s.rgb() * static_cast<float>(f_r) + Rgb(s.w * static_cast<float>(f_m));
         out.sky = Max(sky, Rgb(0.0f));
         out.transmittance = Transmittance(h, mu);
@@ -410,7 +414,7 @@ struct AtmospherePlusDirectEvaluator {
                                                    ClampCosine(Dot(p0, sun) / r), steps, sun_steps);
         const double f_r =
             modified_rayleigh ? AplusModifiedRayleighPhase(nu) : AplusRayleighPhase(nu);
-        out.sky = Rgb(v.rayleigh * f_r + Vec3d(v.mie * AplusMiePhase(atm.mie_phase_g, nu)));
+        out.sky = Rgb(v.rayleigh * f_r + Vec3d(v.mie * AplusMiePhase(atm, nu)));
         out.transmittance = Rgb(Exp(-OpticalDepth(atm, p0, dir, seg.t_end - seg.t_start, steps)));
         return out;
     }

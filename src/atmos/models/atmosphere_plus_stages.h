@@ -194,7 +194,7 @@ struct AplusGatherStage {
                 const double c = ClampCosine(sin_t * cos(phi) * sin_phi + cos(theta) * mu);
                 AplusValue f;
                 f.rayleigh = in.rayleigh * (AplusRayleighPhase(c) * sin_t);
-                f.mie = in.mie * AplusMiePhase(atm.mie_phase_g, c) * sin_t;
+                f.mie = in.mie * AplusMiePhase(atm, c) * sin_t;
                 sum += f * (wx * wy);
             }
         }

@@ -618,7 +618,7 @@ struct BrunetonLut {
             single_mie = single_mie * shadow_t;
         }
         return scattering * static_cast<float>(RayleighPhase(nu)) +
-               single_mie * static_cast<float>(CornetteShanksPhase(atm.mie_phase_g, nu));
+               single_mie * static_cast<float>(MiePhase(atm, nu));
     }
 
     // GetSkyRadianceToPoint: scattering between the camera and `point` (aerial
@@ -680,8 +680,7 @@ struct BrunetonLut {
             }
         }
         return Max(scattering, Rgb(0.0f)) * static_cast<float>(RayleighPhase(nu)) +
-               Max(single_mie, Rgb(0.0f)) *
-                   static_cast<float>(CornetteShanksPhase(atm.mie_phase_g, nu));
+               Max(single_mie, Rgb(0.0f)) * static_cast<float>(MiePhase(atm, nu));
     }
 
     // Single Mie scattering (without the phase function) between the camera at

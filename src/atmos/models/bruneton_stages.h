@@ -271,7 +271,7 @@ struct BrunetonIncidentStage {
             const Rgb ray = lut.GetScattering(single_rayleigh, r, ct, mu_s, nu1, ground).rgb();
             const Rgb mie = lut.GetScattering(single_mie, r, ct, mu_s, nu1, ground).rgb();
             inc = ray * static_cast<float>(RayleighPhase(nu1)) +
-                  mie * static_cast<float>(CornetteShanksPhase(atm.mie_phase_g, nu1));
+                  mie * static_cast<float>(MiePhase(atm, nu1));
         } else {
             inc = lut.GetScattering(multiple, r, ct, mu_s, nu1, ground).rgb();
         }
@@ -376,8 +376,24 @@ struct BrunetonDensityStage {
         const double alt = r - atm.bottom_radius;
         const Vec3d br =
             atm.rayleigh_scattering * (GetProfileDensity(atm.rayleigh_density, alt) * k_r);
-        const Vec3d bm = atm.mie_scattering * (GetProfileDensity(atm.mie_density, alt) * k_m);
-        density.Set(x, y, z, BrunetonVec4(sum_r * Rgb(br) + sum_m * Rgb(bm)));
+        const double rho_m = GetProfileDensity(atm.mie_density, alt);
+        const double w2 = atm.mie_phase_weight2;
+        if (w2 == 0.0) {
+            const Vec3d bm = atm.mie_scattering * (rho_m * k_m);
+            density.Set(x, y, z, BrunetonVec4(sum_r * Rgb(br) + sum_m * Rgb(bm)));
+            return;
+        }
+        // A second Cornette-Shanks lobe (MiePhase): its own phase sums, the
+        // lobes weighted 1 - w2 and w2.
+        const double g2 = atm.mie_phase_g2;
+        Rgb unused, sum_m2;
+        BrunetonPhaseSums(BrunetonDirections(directions), l, static_cast<float>(ox),
+                          static_cast<float>(oy), static_cast<float>(mu), static_cast<float>(g2),
+                          &unused, &sum_m2);
+        const double k_m2 = 3.0 / (8.0 * kPi) * (1.0 - g2 * g2) / (2.0 + g2 * g2);
+        const Vec3d bm = atm.mie_scattering * (rho_m * (1.0 - w2) * k_m);
+        const Vec3d bm2 = atm.mie_scattering * (rho_m * w2 * k_m2);
+        density.Set(x, y, z, BrunetonVec4(sum_r * Rgb(br) + sum_m * Rgb(bm) + sum_m2 * Rgb(bm2)));
     }
 };
 ATMOS_DEVICE_STAGE(BrunetonDensityStage)
@@ -420,7 +436,7 @@ struct BrunetonIndirectIrradianceStage {
                     l = lut.GetScattering(single_rayleigh, r, omega.z, mu_s, nu, false).rgb() *
                             static_cast<float>(RayleighPhase(nu)) +
                         lut.GetScattering(single_mie, r, omega.z, mu_s, nu, false).rgb() *
-                            static_cast<float>(CornetteShanksPhase(lut.atm.mie_phase_g, nu));
+                            static_cast<float>(MiePhase(lut.atm, nu));
                 } else {
                     l = lut.GetScattering(multiple, r, omega.z, mu_s, nu, false).rgb();
                 }

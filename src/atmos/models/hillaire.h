@@ -294,7 +294,7 @@ struct HillaireEvaluator {
         if (!(tb > ta) || n < 1) return;
         const double nu = Dot(dir, sun);
         const double phase_r = RayleighPhase(nu);
-        const double phase_m = CornetteShanksPhase(atm.mie_phase_g, nu);
+        const double phase_m = MiePhase(atm, nu);
         const double dt = (tb - ta) / n;
         for (int i = 0; i < n; ++i) {
             Vec3d p = origin + dir * (ta + (i + segment_offset) * dt);

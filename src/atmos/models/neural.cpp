@@ -266,6 +266,14 @@ NeuralWeights EmbeddedNeuralWeights(const std::string& name) {
     Fail("neural: no shipped weights named '", name, "' (data/neural/", name, ".json)");
 }
 
+void CheckNeuralSingleMieLobe(const AtmosphereParameters& a) {
+    if (a.mie_phase_weight2 != 0.0) {
+        Fail("neural: the atmosphere's mie_phase_weight2 is ", a.mie_phase_weight2,
+             ": the network's input encoding carries one Cornette-Shanks lobe (mie_phase_g), so "
+             "neural takes only mie_phase_weight2 = 0");
+    }
+}
+
 void CheckNeuralWeightsMatch(const NeuralWeights& w, const AtmosphereParameters& a,
                              const std::string& source) {
     const char* fix =
@@ -360,6 +368,7 @@ NeuralModel::NeuralModel(const NeuralOptions& options) {
 }
 
 void NeuralModel::Prepare(const AtmosphereParameters& atmosphere) {
+    CheckNeuralSingleMieLobe(atmosphere);
     SetAtmosphere(atmosphere);
     NeuralWeights w;
     std::string source;

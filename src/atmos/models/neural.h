@@ -163,6 +163,9 @@ std::string NeuralWeightsToJson(const NeuralWeights& weights);
 NeuralWeights LoadNeuralWeights(const std::string& path);
 // The weights shipped in data/neural/<name>.json (embedded at build time).
 NeuralWeights EmbeddedNeuralWeights(const std::string& name);
+// Throws atmos::Error naming mie_phase_weight2 unless it is 0: the network's
+// encoding (NeuralEncodeScattering) carries one Cornette-Shanks lobe.
+void CheckNeuralSingleMieLobe(const AtmosphereParameters& atmosphere);
 // Throws atmos::Error when `weights` were fitted to another atmosphere: every
 // field the fit depends on (all but solar_irradiance: the networks give
 // radiance per unit solar irradiance) is compared, and the message names the

@@ -299,6 +299,7 @@ NeuralFitChoices CheckNeuralFitOptions(const NeuralFitOptions& o) {
 
 NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
                         const NeuralFitOptions& o, NeuralFitReport* report) {
+    CheckNeuralSingleMieLobe(atm);
     const NeuralFitChoices choices = CheckNeuralFitOptions(o);
     const bool large = o.network == "large";
     const NeuralEncoding enc = choices.encoding;

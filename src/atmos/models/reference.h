@@ -37,7 +37,10 @@
 // treat it so too). A Lambertian ground of the atmosphere's albedo: NEE to the
 // sun and a cosine-sampled bounce; albedo 0 ends the path (a black ground that
 // still blocks light). Phase sampling: Rayleigh exactly (Cardano), Cornette-
-// Shanks through Henyey-Greenstein with the weight CS/HG <= 1.5.
+// Shanks through Henyey-Greenstein with the weight CS/HG <= 1.5; a two-lobe
+// Mie phase (mie_phase_weight2 > 0) through the mixture of the lobes'
+// Henyey-Greenstein functions (lobe chosen with probability 1 - w / w, weight
+// P / ((1 - w) HG(g) + w HG(g2)) <= 1.5: physics/sampling.h).
 //
 // Orders: `--max-order K` counts scattering vertices (volume or ground); 0 =
 // unlimited with Russian roulette from the 4th vertex. Random numbers come from
@@ -423,7 +426,7 @@ struct ReferenceEvaluator {
 
     // sigma_R P_R(nu) + sigma_M P_M(nu): the light scattered by angle acos(nu).
     ATMOS_HD Vec3d InScatter(const Vec3d& sigma_r, const Vec3d& sigma_m, double nu) const {
-        return sigma_r * RayleighPhase(nu) + sigma_m * CornetteShanksPhase(atm.mie_phase_g, nu);
+        return sigma_r * RayleighPhase(nu) + sigma_m * MiePhase(atm, nu);
     }
 
     // Chooses the collision's event and weights w by it (c.total > 0).
@@ -590,13 +593,11 @@ struct ReferenceEvaluator {
                 if (max_order > 0 && order > max_order) break;
                 const double nu = Dot(dir, sun);
                 if (SunVisibleDelta(p, sun, shell, c, rng)) {
-                    radiance += w * (rayleigh ? RayleighPhase(nu)
-                                              : CornetteShanksPhase(atm.mie_phase_g, nu));
+                    radiance += w * (rayleigh ? RayleighPhase(nu) : MiePhase(atm, nu));
                 }
                 const Vec3d next = MakeDirection(dir, 1.0 - 2.0 * rng.Uniform(), rng.Uniform());
                 const double mu = Dot(next, dir);
-                w *= 4.0 * kPi *
-                     (rayleigh ? RayleighPhase(mu) : CornetteShanksPhase(atm.mie_phase_g, mu));
+                w *= 4.0 * kPi * (rayleigh ? RayleighPhase(mu) : MiePhase(atm, mu));
                 dir = next;
             }
             if (order >= 3) {
@@ -702,7 +703,7 @@ struct ReferenceEvaluator {
         cuts[nc++] = length;
         const double nu = Dot(dir, sun);
         const double p_r = RayleighPhase(nu);
-        const double p_m = CornetteShanksPhase(atm.mie_phase_g, nu);
+        const double p_m = MiePhase(atm, nu);
         // Phase 1: nodes (positions, Jacobians, densities, sun transmittance).
         int count = 0;
         int piece_start[6], piece_n[6];
@@ -923,7 +924,6 @@ struct ReferenceEvaluator {
         if (!(sun_lobe > 0.0) || Dot(x, sun) >= 0.0) {
             return SamplePhaseDirection(dir, rayleigh, rng, w);
         }
-        const double g = atm.mie_phase_g;
         Vec3d next;
         if (rng.Uniform() < sun_lobe) {
             next = MakeDirection(sun, SampleHenyeyGreensteinCosine(sun_lobe_g, rng.Uniform()),
@@ -931,12 +931,12 @@ struct ReferenceEvaluator {
         } else {
             const double xi = rng.Uniform();
             next = MakeDirection(
-                dir, rayleigh ? SampleRayleighCosine(xi) : SampleHenyeyGreensteinCosine(g, xi),
+                dir, rayleigh ? SampleRayleighCosine(xi) : SampleMiePhaseCosine(atm, xi),
                 rng.Uniform());
         }
         const double mu = Dot(dir, next);
-        const double phase = rayleigh ? RayleighPhase(mu) : CornetteShanksPhase(g, mu);
-        const double p_phase = rayleigh ? phase : HenyeyGreensteinPhase(g, mu);
+        const double phase = rayleigh ? RayleighPhase(mu) : MiePhase(atm, mu);
+        const double p_phase = rayleigh ? phase : MiePhaseSamplingPdf(atm, mu);
         const double pdf = (1.0 - sun_lobe) * p_phase +
                            sun_lobe * HenyeyGreensteinPhase(sun_lobe_g, Dot(next, sun));
         *w = *w * (phase / pdf);
@@ -956,8 +956,7 @@ struct ReferenceEvaluator {
         const Rgb rayleigh =
             guide_lut.CombinedScattering(r, mu, ClampCosine(Dot(x, sun) / r), nu,
                                          RayIntersectsGround(r, mu, atm.bottom_radius), &mie);
-        return Vec3d(rayleigh) * RayleighPhase(nu) +
-               Vec3d(mie) * CornetteShanksPhase(atm.mie_phase_g, nu);
+        return Vec3d(rayleigh) * RayleighPhase(nu) + Vec3d(mie) * MiePhase(atm, nu);
     }
 
     ATMOS_HD bool GuideApplies(const Vec3d& x, const Vec3d& sun) const {
@@ -966,7 +965,7 @@ struct ReferenceEvaluator {
 
     // The order-2 guide at a first vertex x (event chosen, throughput *w;
     // f the event's phase function about dir). Candidates: n directions
-    // omega_i drawn from f (Rayleigh exactly, Mie by Henyey-Greenstein,
+    // omega_i drawn from f (Rayleigh exactly, Mie by Henyey-Greenstein lobes,
     // ratio r_i = f / pdf), stratified (a rank-1 lattice in the two uniform
     // numbers with a random shift, so each is marginally distributed by the
     // pdf); c_i = mean_c(w_c C_c(x, omega_i)).
@@ -989,7 +988,6 @@ struct ReferenceEvaluator {
     ATMOS_HD Vec3d SampleGuidedDirection(const Vec3d& x, const Vec3d& dir, bool rayleigh,
                                          const Vec3d& sun, Rng& rng, Vec3d* w, Vec3d* cv) const {
         const int n = Min(guide_candidates, kMaxGuideCandidates);
-        const double g = atm.mie_phase_g;
         const double xi1 = rng.Uniform(), xi2 = rng.Uniform();
         const bool resample = guide_mode == GuideMode::kResample;
         Vec3d cand[kMaxGuideCandidates];
@@ -1000,9 +998,8 @@ struct ReferenceEvaluator {
             const double u1 = (i + xi1) / n;
             double u2 = xi2 + 0.6180339887498949 * i;
             u2 -= floor(u2);
-            const double mu =
-                rayleigh ? SampleRayleighCosine(u1) : SampleHenyeyGreensteinCosine(g, u1);
-            const double ratio = rayleigh ? 1.0 : CornetteShanksOverHenyeyGreenstein(g, mu);
+            const double mu = rayleigh ? SampleRayleighCosine(u1) : SampleMiePhaseCosine(atm, u1);
+            const double ratio = rayleigh ? 1.0 : MiePhaseOverSamplingPdf(atm, mu);
             cand[i] = MakeDirection(dir, mu, u2);
             const Vec3d c = GuideRadiance(x, cand[i], sun);
             if (resample) {
@@ -1023,15 +1020,14 @@ struct ReferenceEvaluator {
         double total = 0.0;
         for (int i = 0; i < n; ++i) {
             const double mu = Dot(cand[i], dir);
-            const double ratio = rayleigh ? 1.0 : CornetteShanksOverHenyeyGreenstein(g, mu);
+            const double ratio = rayleigh ? 1.0 : MiePhaseOverSamplingPdf(atm, mu);
             q[i] += ratio * delta;
             total += q[i];
         }
         double pick = rng.Uniform() * total;
         int j = 0;
         while (j + 1 < n && pick >= q[j]) pick -= q[j++];
-        const double ratio_j =
-            rayleigh ? 1.0 : CornetteShanksOverHenyeyGreenstein(g, Dot(cand[j], dir));
+        const double ratio_j = rayleigh ? 1.0 : MiePhaseOverSamplingPdf(atm, Dot(cand[j], dir));
         // f / phat mean_i q_i = ratio_j mean_i q_i / q_j.
         *w = *w * (ratio_j * (total / n) / q[j]);
         return cand[j];
@@ -1041,8 +1037,8 @@ struct ReferenceEvaluator {
         if (rayleigh) {
             return MakeDirection(dir, SampleRayleighCosine(rng.Uniform()), rng.Uniform());
         }
-        const double mu = SampleHenyeyGreensteinCosine(atm.mie_phase_g, rng.Uniform());
-        *w = *w * CornetteShanksOverHenyeyGreenstein(atm.mie_phase_g, mu);
+        const double mu = SampleMiePhaseCosine(atm, rng.Uniform());
+        *w = *w * MiePhaseOverSamplingPdf(atm, mu);
         return MakeDirection(dir, mu, rng.Uniform());
     }
 

@@ -40,6 +40,8 @@ AnalyticMedia MakeAnalyticMedia(const AtmosphereParameters& atm) {
     m.ozone = MakeOzoneShell(atm);
     m.ozone_absorption = m.ozone.Empty() ? Vec3d(0.0) : atm.absorption_extinction;
     m.mie_g = atm.mie_phase_g;
+    m.mie_g2 = atm.mie_phase_g2;
+    m.mie_w2 = atm.mie_phase_weight2;
     m.ground_albedo = atm.ground_albedo;
     return m;
 }

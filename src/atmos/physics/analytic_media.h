@@ -27,6 +27,8 @@ struct AnalyticMedia {
     Vec3d ozone_absorption;  // 1/m inside the shell
     OzoneShell ozone;
     double mie_g = 0.8;
+    double mie_g2 = 0.0;  // the second Cornette-Shanks lobe (MiePhase)
+    double mie_w2 = 0.0;  // its weight
     Vec3d ground_albedo;
 
     ATMOS_HD Vec3d Extinction(double l_rayleigh, double l_mie, double l_ozone) const {

@@ -165,6 +165,8 @@ void ValidateAtmosphere(const AtmosphereParameters& a) {
     }
     CheckProfile("mie_density", a.mie_density);
     CheckRange("mie_phase_g", a.mie_phase_g, -1.0, true, 1.0, true, "(-1, 1)");
+    CheckRange("mie_phase_g2", a.mie_phase_g2, -1.0, true, 1.0, true, "(-1, 1)");
+    CheckRange("mie_phase_weight2", a.mie_phase_weight2, 0.0, false, 1.0, false, "[0, 1]");
     CheckCoefficient("absorption_extinction", a.absorption_extinction);
     CheckProfile("absorption_density", a.absorption_density);
     CheckRgbRange("ground_albedo", a.ground_albedo, 0.0, 1.0, "[0, 1]");

@@ -11,9 +11,11 @@
 //                     (seed 003 Eq. 6 writes +2g cos theta with theta measured
 //                      from the backward direction; here nu = +cos of the angle
 //                      between propagation directions, so forward peaks at nu = 1)
+//   Mie:              (1 - w) CS(g) + w CS(g2)                 MiePhase (two lobes)
 //   isotropic:        1/(4 pi)                                  seed 003 Eq. 7
 #pragma once
 
+#include "atmos/atmosphere.h"
 #include "atmos/math.h"
 
 namespace atmos {
@@ -24,6 +26,20 @@ ATMOS_HD inline double CornetteShanksPhase(double g, double nu) {
     const double k = 3.0 / (8.0 * kPi) * (1.0 - g * g) / (2.0 + g * g);
     const double denom = 1.0 + g * g - 2.0 * g * nu;
     return k * (1.0 + nu * nu) / (denom * Sqrt(denom));
+}
+
+// The Mie phase function of an atmosphere: one Cornette-Shanks lobe, or two,
+// (1 - w) CS(g, nu) + w CS(g2, nu) (AtmosphereParameters::mie_phase_weight2).
+// A convex combination of normalised lobes, so normalised. With w = 0 it is
+// CS(g, nu) exactly (the second lobe is not evaluated).
+ATMOS_HD inline double MiePhase(double g, double g2, double w, double nu) {
+    const double p = CornetteShanksPhase(g, nu);
+    if (w == 0.0) return p;
+    return (1.0 - w) * p + w * CornetteShanksPhase(g2, nu);
+}
+
+ATMOS_HD inline double MiePhase(const AtmosphereParameters& atm, double nu) {
+    return MiePhase(atm.mie_phase_g, atm.mie_phase_g2, atm.mie_phase_weight2, nu);
 }
 
 ATMOS_HD inline double HenyeyGreensteinPhase(double g, double nu) {

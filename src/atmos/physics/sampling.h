@@ -4,7 +4,9 @@
 // and the axis it is sampled around; MakeDirection builds the direction.
 #pragma once
 
+#include "atmos/atmosphere.h"
 #include "atmos/math.h"
+#include "physics/phase.h"
 
 namespace atmos {
 
@@ -31,6 +33,37 @@ ATMOS_HD inline double SampleHenyeyGreensteinCosine(double g, double xi) {
 // bounded by 3 / (2 + g^2) <= 1.5.
 ATMOS_HD inline double CornetteShanksOverHenyeyGreenstein(double g, double mu) {
     return 1.5 * (1.0 + mu * mu) / (2.0 + g * g);
+}
+
+// The Mie phase (physics/phase.h MiePhase, one or two Cornette-Shanks lobes)
+// sampled by the mixture of the lobes' Henyey-Greenstein functions: lobe 2
+// with probability w (then HG(g2)), else lobe 1 (HG(g)); one uniform number,
+// rescaled after the choice, so that w = 0 draws exactly as HG(g) alone.
+ATMOS_HD inline double SampleMiePhaseCosine(const AtmosphereParameters& atm, double xi) {
+    const double w = atm.mie_phase_weight2;
+    if (w == 0.0) return SampleHenyeyGreensteinCosine(atm.mie_phase_g, xi);
+    if (xi < w) return SampleHenyeyGreensteinCosine(atm.mie_phase_g2, xi / w);
+    return SampleHenyeyGreensteinCosine(atm.mie_phase_g, (xi - w) / (1.0 - w));
+}
+
+// The density of SampleMiePhaseCosine's directions (per steradian):
+// (1 - w) HG(g, mu) + w HG(g2, mu) (one-sample MIS over the lobes, balance
+// heuristic).
+ATMOS_HD inline double MiePhaseSamplingPdf(const AtmosphereParameters& atm, double mu) {
+    const double w = atm.mie_phase_weight2;
+    const double p = HenyeyGreensteinPhase(atm.mie_phase_g, mu);
+    if (w == 0.0) return p;
+    return (1.0 - w) * p + w * HenyeyGreensteinPhase(atm.mie_phase_g2, mu);
+}
+
+// The weight MiePhase / MiePhaseSamplingPdf of a SampleMiePhaseCosine sample:
+// with one lobe CornetteShanksOverHenyeyGreenstein; with two a ratio of
+// mixtures with the same weights, so at most the larger lobe ratio (<= 1.5).
+ATMOS_HD inline double MiePhaseOverSamplingPdf(const AtmosphereParameters& atm, double mu) {
+    if (atm.mie_phase_weight2 == 0.0) {
+        return CornetteShanksOverHenyeyGreenstein(atm.mie_phase_g, mu);
+    }
+    return MiePhase(atm, mu) / MiePhaseSamplingPdf(atm, mu);
 }
 
 // An orthonormal basis around unit n (Duff et al. 2017, "Building an

@@ -49,7 +49,7 @@ ATMOS_HD inline void FinishSingleScattering(const AtmosphereParameters& atm, con
                                             const Vec3d& tau_view, RayResult* out) {
     const double nu = Dot(dir, sun);
     const Vec3d sky = atm.rayleigh_scattering * sum_r * RayleighPhase(nu) +
-                      atm.mie_scattering * sum_m * CornetteShanksPhase(atm.mie_phase_g, nu);
+                      atm.mie_scattering * sum_m * MiePhase(atm, nu);
     const Vec3d t_view = Exp(-tau_view);
     out->sky = Rgb(sky);
     out->transmittance = Rgb(t_view);
