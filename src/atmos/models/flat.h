@@ -117,7 +117,7 @@ struct FlatEvaluator {
         const Vec3d e = LinearExpIntegral(t0, t1);
         const double nu = Dot(dir, sun);
         const Vec3d sky = (m.rayleigh_scattering * (l.rayleigh * RayleighPhase(nu)) +
-                           m.mie_scattering * (l.mie * MiePhase(m.mie_g, m.mie_g2, m.mie_w2, nu))) *
+                           m.mie_scattering * (l.mie * m.MiePhaseAt(nu))) *
                           e;
         const Vec3d t_view = Exp(-tau);
         out.sky = Rgb(sky);

@@ -196,7 +196,7 @@ struct OneilEvaluator {
         }
         const double nu = dir_sun;
         const Vec3d sky = m.rayleigh_scattering * sum_r * RayleighPhase(nu) +
-                          m.mie_scattering * sum_m * MiePhase(m.mie_g, m.mie_g2, m.mie_w2, nu);
+                          m.mie_scattering * sum_m * m.MiePhaseAt(nu);
         const Vec3d t_view = Exp(-optics.SegmentDepth(camera, dir, seg.t_start, seg.t_end));
         out.sky = Rgb(sky);
         out.transmittance = Rgb(t_view);

@@ -61,7 +61,7 @@ struct RaymarchedEvaluator {
         }
         const double nu = Dot(dir, sun);
         const Vec3d sky = m.rayleigh_scattering * sum_r * RayleighPhase(nu) +
-                          m.mie_scattering * sum_m * MiePhase(m.mie_g, m.mie_g2, m.mie_w2, nu);
+                          m.mie_scattering * sum_m * m.MiePhaseAt(nu);
         const Vec3d t_view = Exp(-tau_view);
         out.sky = Rgb(sky);
         out.transmittance = Rgb(t_view);

@@ -35,6 +35,8 @@ struct AnalyticMedia {
         return rayleigh_scattering * l_rayleigh + mie_extinction * l_mie +
                ozone_absorption * l_ozone;
     }
+    // The atmosphere's Mie phase (one or two Cornette-Shanks lobes: phase.h).
+    ATMOS_HD double MiePhaseAt(double nu) const { return MiePhase(mie_g, mie_g2, mie_w2, nu); }
 };
 
 AnalyticMedia MakeAnalyticMedia(const AtmosphereParameters& atm);
