@@ -239,10 +239,7 @@ int CmdValidate(const ValidateOptions& o) {
         const ModelSpec spec = ParseModelSpec(model_text);
         const MonteCarloSettings mc = MakeMonteCarloSettings(o.spp, o.seed, 0, "--spp");
         const auto start = std::chrono::steady_clock::now();
-        const std::vector<double> values = SampleSpectral(
-            spec, atmosphere, nm, queries, mc,
-            [](const AtmosphereParameters& a, Model* model) { model->Prepare(a); },
-            kPerWavelengthBatching);
+        const std::vector<double> values = KiderModelSpectra(spec, atmosphere, nm, queries, mc);
         const double seconds = Seconds(start);
         if (!o.html.empty()) all_values.push_back(values);
         if (!o.values.empty()) {

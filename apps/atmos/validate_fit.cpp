@@ -99,14 +99,22 @@ int KiderBinIndex(double nm) {
     return -1;
 }
 
+std::vector<double> KiderModelSpectra(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
+                                      const std::vector<double>& nm,
+                                      const std::vector<SampleQuery>& queries,
+                                      const MonteCarloSettings& monte_carlo) {
+    return SampleSpectral(
+        spec, atmosphere, nm, queries, monte_carlo,
+        [](const AtmosphereParameters& p, Model* model) { model->Prepare(p); },
+        kPerWavelengthBatching);
+}
+
 double KiderResidual(const AerosolFitSettings& settings, const std::string& atmosphere,
                      const std::vector<std::string>& sets, const std::vector<KiderSample>& samples,
                      const std::vector<SampleQuery>& queries) {
     const SpectralAtmosphere a = LoadSpectralAtmosphere(atmosphere, sets);
-    const std::vector<double> values = SampleSpectral(
-        ParseModelSpec(settings.model), a, settings.nm, queries, settings.monte_carlo,
-        [](const AtmosphereParameters& p, Model* model) { model->Prepare(p); },
-        kPerWavelengthBatching);
+    const std::vector<double> values = KiderModelSpectra(
+        ParseModelSpec(settings.model), a, settings.nm, queries, settings.monte_carlo);
     ErrorSum e;
     for (size_t q = 0; q < samples.size(); ++q) {
         for (size_t i = 0; i < settings.nm.size(); ++i) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "atmos/model.h"
+#include "atmos/spectral.h"
 #include "harness/kider.h"
 
 namespace atmos::cli {
@@ -49,6 +50,15 @@ struct AerosolFit {
     // `sets` plus the fitted --set overrides (FIELD=VALUE, %.6g).
     std::vector<std::string> sets;
 };
+
+// The spectral radiance validate scores, [query * nm.size() + i]: `spec` sampled
+// at the queries and Kider bins with a plain Prepare(), in the batches that keep
+// each wavelength's own value least noisy (kPerWavelengthBatching); the fit and
+// the evaluation both use it.
+std::vector<double> KiderModelSpectra(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
+                                      const std::vector<double>& nm,
+                                      const std::vector<SampleQuery>& queries,
+                                      const MonteCarloSettings& monte_carlo);
 
 // The relative RMSE of `model` with the atmosphere `atmosphere` + `sets` against
 // the measured `samples` at the Kider bins `nm`.
