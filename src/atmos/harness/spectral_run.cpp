@@ -16,13 +16,13 @@ namespace atmos {
 
 namespace {
 
-// Channel c of a batch stores its wavelength unless an earlier channel holds the
-// same index (the repeats that fill a short batch).
-bool StoresChannel(const std::array<size_t, 3>& batch, size_t c) {
-    for (size_t k = 0; k < c; ++k) {
-        if (batch[k] == batch[c]) return false;
-    }
-    return true;
+// The channels of a batch that store their wavelength: all but the repeats that
+// fill a short batch, which SpectralBatches puts last (both layouts' indices grow
+// with the channel), so a prefix.
+size_t StoredChannels(const std::array<size_t, 3>& batch) {
+    size_t count = 1;
+    while (count < 3 && batch[count] != batch[count - 1]) ++count;
+    return count;
 }
 
 std::unique_ptr<Model> PrepareBatch(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
@@ -106,6 +106,7 @@ std::vector<SpectralImage> RenderSpectralRequests(
     const std::vector<std::array<size_t, 3>> batches = SpectralBatches(n, batching.layout);
     for (size_t b = 0; b < batches.size(); ++b) {
         const double l[3] = {nm[batches[b][0]], nm[batches[b][1]], nm[batches[b][2]]};
+        const size_t stored = StoredChannels(batches[b]);
         AtmosphereParameters batch;
         std::unique_ptr<Model> model = PrepareBatch(spec, atmosphere, l, prepare, &batch);
         for (size_t v = 0; v < requests.size(); ++v) {
@@ -130,10 +131,8 @@ std::vector<SpectralImage> RenderSpectralRequests(
             }
             const size_t pixels = static_cast<size_t>(r.width) * r.height;
             for (size_t p = 0; p < pixels; ++p) {
-                for (size_t c = 0; c < 3; ++c) {
-                    if (StoresChannel(batches[b], c)) {
-                        out[v].values[p * n + batches[b][c]] = image.data()[p * 3 + c];
-                    }
+                for (size_t c = 0; c < stored; ++c) {
+                    out[v].values[p * n + batches[b][c]] = image.data()[p * 3 + c];
                 }
             }
         }
@@ -168,6 +167,7 @@ std::vector<double> SampleSpectral(const ModelSpec& spec, const SpectralAtmosphe
     const std::vector<std::array<size_t, 3>> batches = SpectralBatches(n, batching.layout);
     for (size_t b = 0; b < batches.size(); ++b) {
         const double l[3] = {nm[batches[b][0]], nm[batches[b][1]], nm[batches[b][2]]};
+        const size_t stored = StoredChannels(batches[b]);
         AtmosphereParameters batch;
         std::unique_ptr<Model> model = PrepareBatch(spec, atmosphere, l, prepare, &batch);
         MonteCarloSettings mc = monte_carlo;
@@ -176,8 +176,7 @@ std::vector<double> SampleSpectral(const ModelSpec& spec, const SpectralAtmosphe
                                                       ? SampleMonteCarlo(*model, queries, mc)
                                                       : model->Sample(queries);
         for (size_t q = 0; q < queries.size(); ++q) {
-            for (size_t c = 0; c < 3; ++c) {
-                if (!StoresChannel(batches[b], c)) continue;
+            for (size_t c = 0; c < stored; ++c) {
                 const int ci = static_cast<int>(c);
                 out[q * n + batches[b][c]] =
                     static_cast<double>(answers[q].radiance[ci]) * batch.solar_irradiance[ci];
