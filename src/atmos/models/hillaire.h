@@ -27,7 +27,8 @@
 //      L += T_acc (S - S e^(-sigma_t dt)) / sigma_t,  T_acc *= e^(-sigma_t dt)
 //    (Hillaire 2015, "energy-conserving" integration, used by the paper).
 //    T_sun from the transmittance table, Psi_ms from the multiple-scattering
-//    table, Rayleigh phase and Cornette-Shanks for Mie.
+//    table, Rayleigh phase and Cornette-Shanks for Mie (one or two lobes,
+//    physics/phase.h MiePhase).
 //  * Sky-view table (per frame: depends on the camera's altitude and the sun's
 //    zenith angle), 192 x 108: u = sqrt(0.5 - 0.5 cos(azimuth to the sun)),
 //    v < 0.5 above the horizon with v = 0.5 (1 - sqrt(1 - theta / theta_h)),

@@ -14,7 +14,8 @@
 // depth accumulated along the view ray up to the midpoint, and T_sun(x_i) from
 // `light_steps` midpoint samples of the light ray to the top of the atmosphere.
 // A light ray that hits the ground contributes nothing (the planet's shadow).
-// Phases: Rayleigh 3/(16 pi)(1+nu^2), Cornette-Shanks for Mie.
+// Phases: Rayleigh 3/(16 pi)(1+nu^2), Cornette-Shanks for Mie (one or two
+// lobes: physics/phase.h MiePhase).
 //
 // Output: radiance per unit solar irradiance (1/sr), transmittance of the
 // segment. Ground (albedo a): a/pi max(0, n.s) T_sun T_view, the direct sun only

@@ -32,7 +32,8 @@
 //     P_M for in-scattering (he has no absorption: with extinction =
 //     scattering the two coincide); his g = -0.99 (negative = forward in his
 //     convention) is our mie_phase_g with the opposite sign; the phase is the
-//     same Cornette-Shanks form;
+//     same Cornette-Shanks form (plus the atmosphere's optional second lobe:
+//     physics/phase.h MiePhase);
 //   * ESun = the solar irradiance: the output is per unit irradiance, as every
 //     model's.
 // No ozone (O'Neil has none).
