@@ -112,15 +112,18 @@ std::vector<double> KiderModelSpectra(const ModelSpec& spec, const SpectralAtmos
 double KiderResidual(const AerosolFitSettings& settings, const std::string& atmosphere,
                      const std::vector<std::string>& sets, const std::vector<KiderSample>& samples,
                      const std::vector<SampleQuery>& queries) {
+    std::vector<int> bins;
+    for (double l : settings.nm) {
+        bins.push_back(KiderBinIndex(l));
+        if (bins.back() < 0) Fail("--fit-wavelengths: ", l, " nm is not a Kider bin");
+    }
     const SpectralAtmosphere a = LoadSpectralAtmosphere(atmosphere, sets);
     const std::vector<double> values = KiderModelSpectra(
         ParseModelSpec(settings.model), a, settings.nm, queries, settings.monte_carlo);
     ErrorSum e;
     for (size_t q = 0; q < samples.size(); ++q) {
-        for (size_t i = 0; i < settings.nm.size(); ++i) {
-            const int bin = KiderBinIndex(settings.nm[i]);
-            if (bin < 0) Fail("--fit-wavelengths: ", settings.nm[i], " nm is not a Kider bin");
-            e.Add(values[q * settings.nm.size() + i], samples[q].spectrum[bin]);
+        for (size_t i = 0; i < bins.size(); ++i) {
+            e.Add(values[q * bins.size() + i], samples[q].spectrum[bins[i]]);
         }
     }
     return e.RelativeRmse();
