@@ -104,7 +104,7 @@ void ExpectBrowserMatchesAtmosRender(const std::string& sets) {
 
     // Small tables and 2 orders keep the bake quick (the shaders read any
     // sizes: bruneton_constants.glsl); combined Mie storage exercises the
-    // shader's extrapolated-Mie path (the default, separate, is in the README's
+    // shader's extrapolated-Mie path (the default, separate, is in docs/manual.md's
     // measurements, docs/engine.md).
     const std::string bruneton =
         "bruneton:orders=2:scattering-r=16:scattering-mu=64:scattering-mu-s=16:mie-storage="
