@@ -2,6 +2,7 @@
 // clear sky of Kider et al. 2014 (harness/kider.h), errors as CSV.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -63,6 +64,24 @@ std::vector<std::string> SplitList(const std::string& text) {
         if (!item.empty()) items.push_back(item);
     }
     return items;
+}
+
+// The bins a model answers: a model whose spectral form covers only part of
+// the range (hosek-wilkie: 320-720 nm) refuses the others in SetSpectralBatch;
+// its errors are then over the bins it answers (the rest are NaN, skipped).
+std::vector<bool> ModelBins(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
+                            const std::vector<double>& nm) {
+    std::vector<bool> ok(nm.size(), true);
+    const std::unique_ptr<Model> model = CreateModel(spec.name, spec.options);
+    for (size_t i = 0; i < nm.size(); ++i) {
+        const double three[3] = {nm[i], nm[i], nm[i]};
+        try {
+            model->SetSpectralBatch(atmosphere, three);
+        } catch (const Error&) {
+            ok[i] = false;
+        }
+    }
+    return ok;
 }
 
 // Bands of the 40 bins (nm, lower bound included). "360-720nm" is the range of
@@ -239,7 +258,20 @@ int CmdValidate(const ValidateOptions& o) {
         const ModelSpec spec = ParseModelSpec(model_text);
         const MonteCarloSettings mc = MakeMonteCarloSettings(o.spp, o.seed, 0, "--spp");
         const auto start = std::chrono::steady_clock::now();
-        const std::vector<double> values = KiderModelSpectra(spec, atmosphere, nm, queries, mc);
+        const std::vector<bool> answered = ModelBins(spec, atmosphere, nm);
+        std::vector<double> model_nm;
+        for (size_t i = 0; i < nm.size(); ++i) {
+            if (answered[i]) model_nm.push_back(nm[i]);
+        }
+        if (model_nm.empty()) Fail("validate: model ", model_text, " answers none of the bins");
+        const std::vector<double> answers =
+            KiderModelSpectra(spec, atmosphere, model_nm, queries, mc);
+        std::vector<double> values(queries.size() * nm.size(), std::nan(""));
+        for (size_t q = 0, k = 0; q < queries.size(); ++q) {
+            for (size_t i = 0; i < nm.size(); ++i) {
+                if (answered[i]) values[q * nm.size() + i] = answers[k++];
+            }
+        }
         const double seconds = Seconds(start);
         if (!o.html.empty()) all_values.push_back(values);
         if (!o.values.empty()) {
@@ -270,6 +302,7 @@ int CmdValidate(const ValidateOptions& o) {
             const KiderSample& s = samples[q];
             for (int i = 0; i < kKiderBins; ++i) {
                 const double m = values[q * nm.size() + static_cast<size_t>(i)];
+                if (std::isnan(m)) continue;  // a bin the model does not answer
                 const double d = s.spectrum[i];
                 for (const Band& band : kBands) {
                     if (nm[static_cast<size_t>(i)] < band.lo ||
@@ -299,6 +332,7 @@ int CmdValidate(const ValidateOptions& o) {
         // One row per bin, all captures pooled (scope "<nm>nm").
         for (double l : nm) {
             const std::string label = WavelengthLabel(l);
+            if (per_bin.count(label) == 0) continue;  // not answered
             const auto& [e, model_sum] = per_bin[label];
             row(model_text, "all", label + "nm", "all", e, model_sum);
         }
@@ -306,9 +340,9 @@ int CmdValidate(const ValidateOptions& o) {
         if (!o.quiet) {
             std::fprintf(stderr,
                          "%s: relative RMSE %.2f %%, absolute %.3f e-3 W m^-2 sr^-1 nm^-1 over %zu "
-                         "directions x 40 bins (%.1f s)\n",
+                         "directions x %zu bins (%.1f s)\n",
                          model_text.c_str(), 100.0 * total.RelativeRmse(),
-                         1e3 * total.AbsoluteRmse(), samples.size(), seconds);
+                         1e3 * total.AbsoluteRmse(), samples.size(), model_nm.size(), seconds);
             const ErrorSum& csm = sums["all|360-720nm|all"].first;
             std::fprintf(stderr,
                          "  360-720nm (clear-sky-models' range) absolute RMSE %.3f e-3, relative "

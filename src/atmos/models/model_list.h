@@ -21,6 +21,7 @@
 #include "models/empty.h"
 #include "models/flat.h"
 #include "models/hillaire.h"
+#include "models/hosek_wilkie.h"
 #include "models/naive.h"
 #include "models/neural.h"
 #include "models/oneil.h"
@@ -45,6 +46,7 @@
     X(FlatModel, FlatEvaluator)                                                            \
     X(RaymarchedModel, RaymarchedEvaluator)                                                \
     X(PreethamModel, PreethamEvaluator)                                                    \
+    X(HosekWilkieModel, HosekWilkieEvaluator)                                              \
     X(TransmittanceReferenceModel, TransmittanceEvaluator<ReferenceTransmittanceOptics>)   \
     X(TransmittanceFlatModel, TransmittanceEvaluator<FlatOptics>)                          \
     X(TransmittanceErfcModel, TransmittanceEvaluator<ErfcTransmittanceOptics>)             \
