@@ -12,6 +12,7 @@
 
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "bake_shaders.h"
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "embedded_assets.h"
@@ -64,6 +65,7 @@ std::string BakeInto(const CommonOptions& common, const std::string& dir) {
         fs::create_directories(fs::path(dir) / "shaders");
         WriteText(fs::path(dir) / ShaderAsset(spec.name), shader);
         WriteText(fs::path(dir) / kCommonShader, FindAsset(kCommonShader));
+        WriteEngineShaders(dir, spec.name, common.quiet);  // Vulkan, HLSL, Metal
     }
     if (!common.quiet) {
         std::fprintf(stderr, "baked %s (precomputed in %.3f s) into %s\n", common.model.c_str(),
