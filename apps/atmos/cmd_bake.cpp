@@ -12,6 +12,7 @@
 
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "bake_rgba.h"
 #include "bake_shaders.h"
 #include "base/parallel.h"
 #include "cli_common.h"
@@ -169,8 +170,16 @@ Command AddBakeCommand(CLI::App* root) {
         "precompute a model's lookup tables and write them (EXR, raw float32/float16, JSON) and "
         "the GLSL that reads them (DIR/shaders/) to a directory",
         common.get(), output.get());
-    c.run = [common, output] {
-        BakeInto(*common, *output);
+    auto layout = std::make_shared<std::string>("rgb");
+    c.app
+        ->add_option("--layout", *layout,
+                     "rgb: the 3-channel blobs (tables.f32/.f16, smallest, WebGL2); rgba: also "
+                     "RGBA32F/RGBA16F blobs (tables_rgba.*) and KTX2 files (DIR/ktx2/)")
+        ->check(CLI::IsMember({"rgb", "rgba"}))
+        ->capture_default_str();
+    c.run = [common, output, layout] {
+        const std::string name = BakeInto(*common, *output);
+        if (*layout == "rgba") WriteRgbaTables(*output, name);
         return 0;
     };
     return c;
