@@ -23,7 +23,8 @@ fi
 packages=(cmake g++ make ninja-build pkg-config libopenexr-dev libpng-dev nlohmann-json3-dev
           libcli11-dev libnlopt-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev clang-format
           chromium fonts-dejavu-core
-          python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib)
+          python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
+          python3-ephem glslang-tools spirv-cross spirv-tools)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -91,5 +91,6 @@ Command AddLocCommand(CLI::App* root);
 Command AddFitCommand(CLI::App* root);
 Command AddValidateCommand(CLI::App* root);
 Command AddReferenceProvenanceCommand(CLI::App* root);
+Command AddSunCommand(CLI::App* root);
 
 }  // namespace atmos::cli

@@ -12,6 +12,8 @@
 
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "bake_rgba.h"
+#include "bake_shaders.h"
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "embedded_assets.h"
@@ -64,6 +66,7 @@ std::string BakeInto(const CommonOptions& common, const std::string& dir) {
         fs::create_directories(fs::path(dir) / "shaders");
         WriteText(fs::path(dir) / ShaderAsset(spec.name), shader);
         WriteText(fs::path(dir) / kCommonShader, FindAsset(kCommonShader));
+        WriteEngineShaders(dir, spec.name, common.quiet);  // Vulkan, HLSL, Metal
     }
     if (!common.quiet) {
         std::fprintf(stderr, "baked %s (precomputed in %.3f s) into %s\n", common.model.c_str(),
@@ -167,8 +170,16 @@ Command AddBakeCommand(CLI::App* root) {
         "precompute a model's lookup tables and write them (EXR, raw float32/float16, JSON) and "
         "the GLSL that reads them (DIR/shaders/) to a directory",
         common.get(), output.get());
-    c.run = [common, output] {
-        BakeInto(*common, *output);
+    auto layout = std::make_shared<std::string>("rgb");
+    c.app
+        ->add_option("--layout", *layout,
+                     "rgb: the 3-channel blobs (tables.f32/.f16, smallest, WebGL2); rgba: also "
+                     "RGBA32F/RGBA16F blobs (tables_rgba.*) and KTX2 files (DIR/ktx2/)")
+        ->check(CLI::IsMember({"rgb", "rgba"}))
+        ->capture_default_str();
+    c.run = [common, output, layout] {
+        const std::string name = BakeInto(*common, *output);
+        if (*layout == "rgba") WriteRgbaTables(*output, name);
         return 0;
     };
     return c;

@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
         AddFitCommand(&app),
         AddValidateCommand(&app),
         AddReferenceProvenanceCommand(&app),
+        AddSunCommand(&app),
     };
     try {
         if (argc > 1 && argv[1][0] != '-') {

@@ -22,11 +22,12 @@ import os as _os
 import numpy as _np
 
 from . import _atmos
+from ._sun import sun_position
 
 __all__ = [
     "Atmosphere", "Model", "FlipResult", "RmseResult", "models", "model_info", "views",
     "view_names", "atmosphere_presets", "flip", "rmse", "bake", "read_image", "write_image",
-    "set_threads", "thread_count",
+    "set_threads", "thread_count", "sun_position",
 ]
 
 

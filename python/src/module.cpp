@@ -24,6 +24,7 @@
 #include "atmos/error.h"
 #include "atmos/image.h"
 #include "atmos/model.h"
+#include "atmos/sun_position.h"
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "metrics/flip.h"
@@ -514,4 +515,51 @@ PYBIND11_MODULE(_atmos, mod) {
         },
         py::arg("threads"));
     mod.def("thread_count", &ParallelThreadCount);
+    // atmos.sun_position (python/atmos/_sun.py): ISO-8601 texts and degrees,
+    // flattened and broadcast by the caller; the same parser, range checks and
+    // SPA as `atmos sun`. Errors name the argument and the element.
+    mod.def(
+        "sun_position",
+        [](const std::vector<std::string>& times, const std::vector<double>& latitudes,
+           const std::vector<double>& longitudes, double height, double pressure,
+           double temperature, double delta_t, bool refraction) {
+            const size_t n = times.size();
+            if (latitudes.size() != n || longitudes.size() != n) {
+                Fail("times, latitudes and longitudes must have the same length");
+            }
+            SunPositionSettings settings;
+            settings.delta_t_s = delta_t;
+            settings.refraction = refraction;
+            settings.pressure_mbar = pressure;
+            settings.temperature_c = temperature;
+            CheckSunSettings(settings, "sun_position");
+            std::vector<double> jd(n);
+            std::vector<SunObserver> observers(n);
+            for (size_t i = 0; i < n; ++i) {
+                const std::string index = "[" + std::to_string(i) + "]";
+                jd[i] = ParseIso8601(times[i], "times" + index);
+                SunObserver only_latitude;
+                only_latitude.latitude_deg = latitudes[i];
+                CheckSunObserver(only_latitude, "latitudes" + index);
+                SunObserver only_longitude;
+                only_longitude.longitude_deg = longitudes[i];
+                CheckSunObserver(only_longitude, "longitudes" + index);
+                SunObserver only_height;
+                only_height.height_m = height;
+                CheckSunObserver(only_height, "height");
+                observers[i] = {latitudes[i], longitudes[i], height};
+            }
+            py::array_t<double> elevation(static_cast<py::ssize_t>(n));
+            py::array_t<double> azimuth(static_cast<py::ssize_t>(n));
+            double* e = elevation.mutable_data();
+            double* a = azimuth.mutable_data();
+            for (size_t i = 0; i < n; ++i) {
+                const SunPosition p = ComputeSunPosition(jd[i], observers[i], settings);
+                e[i] = p.elevation_deg;
+                a[i] = p.azimuth_deg;
+            }
+            return py::make_tuple(elevation, azimuth);
+        },
+        py::arg("times"), py::arg("latitudes"), py::arg("longitudes"), py::arg("height"),
+        py::arg("pressure"), py::arg("temperature"), py::arg("delta_t"), py::arg("refraction"));
 }
