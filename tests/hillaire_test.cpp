@@ -3,9 +3,11 @@
 // and its single-scattering part against the `naive` model.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -20,6 +22,7 @@
 #include "models/hillaire.h"
 #include "models/naive.h"
 #include "physics/transmittance.h"
+#include "render/render.h"
 
 namespace atmos {
 namespace {
@@ -592,7 +595,7 @@ TEST(Hillaire, BakeRoundTrip) {
 }
 
 TEST(Hillaire, SampleTablePathMatchesMarchPath) {
-    // `sample` through the per-(altitude, sun) sky-view tables against the ray
+    // `sample` through the sky-view table of each query's altitude and sun against the ray
     // march of every query, both with 40 steps and midpoint samples
     // (--sky-view-steps 40, --segment-offset 0.5) so
     // that the comparison isolates the table path; with the demo's offset
@@ -633,6 +636,40 @@ TEST(Hillaire, SampleTablePathMatchesMarchPath) {
     }
     std::printf("40-step march transmittance, offset 0.3 vs 0.5: max %.1f %%\n",
                 100.0 * worst_offset_t);
+}
+
+// Issue 33 item 1: `sample` (sample-path=table) computes, per query, the four
+// sky-view texels its lookup reads; its answer must be the bits of a lookup in
+// the full sky-view table of that query's camera and sun (what a render's frame
+// builds, HillaireModel::BuildFrame), however the batch is made up.
+TEST(Hillaire, SamplePerQueryTexelsAreTheFrameTablesBits) {
+    const auto model = MakeModel(EarthAtmosphere(), {{"sky-view-steps", "20"}});
+    const AtmosphereParameters& atm = model->atmosphere();
+    const std::vector<SampleQuery> queries = {{0.0, 1.0, 1.0, 0.0},       {0.0, 0.05, 0.02, 3.0},
+                                              {1500.0, -0.3, 0.4, 120.0}, {12e3, 0.3, -0.1, 200.0},
+                                              {0.5, 0.999, 0.7, 45.0},    {60e3, -0.8, 0.9, 359.0},
+                                              {0.0, -0.02, 0.3, 180.0},   {8e3, 0.0, 0.0, 90.0}};
+    const std::vector<SampleAnswer> batch = model->Sample(queries);
+    for (size_t k = 0; k < queries.size(); ++k) {
+        SCOPED_TRACE("query " + std::to_string(k));
+        const SampleQuery& q = queries[k];
+        // The camera and sun of SampleOne (render/render.h).
+        const Vec3d camera(0.0, 0.0, atm.bottom_radius + q.altitude_m);
+        const double sin_s = std::sqrt(std::max(0.0, 1.0 - q.mu_s * q.mu_s));
+        const double az = Radians(q.azimuth_deg);
+        const Vec3d sun(sin_s * std::cos(az), sin_s * std::sin(az), q.mu_s);
+        const double r = Length(camera);
+        Table sky_view;
+        model->BuildSkyView(r, ClampCosine(Dot(sun, camera) / r), &sky_view);
+        HillaireEvaluator e = model->MakeEvaluator();
+        e.sky_view = sky_view.view();
+        const SampleAnswer full = SampleAll(e, atm.bottom_radius, {q})[0];
+        EXPECT_EQ(std::memcmp(&full, &batch[k], sizeof(SampleAnswer)), 0)
+            << "full table " << full.radiance[0] << ", per-query texels " << batch[k].radiance[0];
+        // Alone: the same bits as in the batch.
+        const SampleAnswer alone = model->Sample({q})[0];
+        EXPECT_EQ(std::memcmp(&alone, &batch[k], sizeof(SampleAnswer)), 0);
+    }
 }
 
 TEST(HillaireCli, BakeThenRenderWithLoadMatchesPrepare) {

@@ -1,8 +1,11 @@
 #include "cli_common.h"
 
+#include <cstdio>
+
 #include "atmos/error.h"
 #include "atmos/model.h"
 #include "base/library_progress.h"
+#include "harness/table_cache.h"
 
 namespace atmos::cli {
 
@@ -30,6 +33,10 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
     cmd->add_option("--load", o->load,
                     "read the model's tables from a directory written by `atmos bake` instead of "
                     "precomputing them");
+    cmd->add_flag("--no-cache", o->no_cache,
+                  "precompute the model's tables: neither read nor write the table cache "
+                  "($XDG_CACHE_HOME/atmos/tables, else ~/.cache/atmos/tables; also "
+                  "ATMOS_NO_CACHE=1; size limit ATMOS_CACHE_MAX_MB, default 2048)");
 }
 
 void AddBackendOption(CLI::App* cmd, std::string* backend) {
@@ -76,7 +83,16 @@ double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphe
     // Precomputations over a second show a progress bar (issue 18 item 9).
     const LibraryProgressScope progress(!o.quiet);
     if (o.load.empty()) {
-        model->Prepare(atmosphere);
+        // Through the table cache (harness/table_cache.h) for models with
+        // tables; the model was created from o.model.
+        const TablePrepareResult r = PrepareWithTableCache(model, GivenModel(o).options, atmosphere,
+                                                           UserTableCache(o.no_cache));
+        if (r.from_cache && !o.quiet) {
+            std::fprintf(stderr,
+                         "tables of %s from the cache %s (computed in %.3f s; --no-cache "
+                         "to recompute)\n",
+                         o.model.c_str(), r.entry.c_str(), r.prepare_seconds);
+        }
     } else {
         model->LoadBaked(o.load, atmosphere);
     }

@@ -28,7 +28,8 @@ struct CommonOptions {
     int threads = 0;
     std::string backend = "cpu";  // --backend cpu|cuda (base/parallel.h)
     bool quiet = false;
-    std::string load;  // --load DIR: read baked tables instead of Prepare()
+    std::string load;       // --load DIR: read baked tables instead of Prepare()
+    bool no_cache = false;  // --no-cache: neither read nor write the table cache
 };
 
 void AddCommonOptions(CLI::App* cmd, CommonOptions* o);

@@ -2,10 +2,12 @@
 // engines (EXR, raw float32/float16, JSON) with the GLSL that reads them; and
 // `atmos viewer`: those, for the models with shaders (bruneton, hillaire,
 // atmosphere-plus), in a WebGL2 page.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -155,9 +157,45 @@ Command AddOutputCommand(CLI::App* root, const char* name, const char* descripti
                          CommonOptions* common, std::string* output) {
     Command c;
     c.app = root->add_subcommand(name, description);
+    // A model that bakes (the shared default, naive, has no tables).
+    common->model = "bruneton";
     AddCommonOptions(c.app, common);
     c.app->add_option("-o,--output", *output, "output directory")->required();
     return c;
+}
+
+// The model spec of the bake in `dir` (--load without --model): the JSON a
+// model's Bake writes names the model ("model") and every option ("options").
+std::string BakedModelSpec(const std::string& dir) {
+    std::vector<fs::path> jsons;
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+        if (e.path().extension() == ".json") jsons.push_back(e.path());
+    }
+    std::sort(jsons.begin(), jsons.end());
+    for (const fs::path& path : jsons) {
+        std::ifstream in(path);
+        nlohmann::json j;
+        try {
+            in >> j;
+        } catch (const std::exception&) {
+            continue;
+        }
+        if (!j.is_object() || !j.contains("model") || !j["model"].is_string()) continue;
+        const std::string name = j["model"].get<std::string>();
+        bool known = false;
+        for (const ModelInfo& info : ListModels()) known = known || info.name == name;
+        if (!known) continue;
+        std::string spec = name;
+        if (j.contains("options") && j["options"].is_object()) {
+            for (const auto& [option, value] : j["options"].items()) {
+                spec += ":" + option + "=" +
+                        (value.is_string() ? value.get<std::string>() : value.dump());
+            }
+        }
+        return spec;
+    }
+    Fail("--load ", dir, ": no bake here (a JSON naming its \"model\", written by atmos bake)");
 }
 
 }  // namespace
@@ -177,7 +215,11 @@ Command AddBakeCommand(CLI::App* root) {
                      "RGBA32F/RGBA16F blobs (tables_rgba.*) and KTX2 files (DIR/ktx2/)")
         ->check(CLI::IsMember({"rgb", "rgba"}))
         ->capture_default_str();
-    c.run = [common, output, layout] {
+    CLI::Option* model_flag = c.app->get_option("--model");
+    c.run = [common, output, layout, model_flag] {
+        if (!common->load.empty() && model_flag->count() == 0) {
+            common->model = BakedModelSpec(common->load);
+        }
         const std::string name = BakeInto(*common, *output);
         if (*layout == "rgba") WriteRgbaTables(*output, name);
         return 0;
@@ -198,7 +240,7 @@ Command AddViewerCommand(CLI::App* root) {
         ->add_option("--models", *models,
                      "models to bake, NAME[:OPTION=VALUE...] comma-separated (default: "
                      "bruneton,hillaire,atmosphere-plus); with --load DIR, one model read "
-                     "from DIR")
+                     "from DIR (default: the model of DIR's bake)")
         ->delimiter(',');
     CLI::Option* model_flag = c.app->get_option("--model");
     c.run = [common, output, models, model_flag] {
@@ -207,6 +249,7 @@ Command AddViewerCommand(CLI::App* root) {
             if (!specs.empty()) Fail("give --models or --model, not both");
             specs.push_back(common->model);  // --model: one model, as for bake
         }
+        if (specs.empty() && !common->load.empty()) specs = {BakedModelSpec(common->load)};
         if (specs.empty()) specs = {"bruneton", "hillaire", "atmosphere-plus"};
         if (!common->load.empty() && specs.size() != 1) {
             Fail("--load reads one model's tables: give one model in --models");

@@ -234,13 +234,18 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
         cmd->add_option("--reference-noise", o->reference_noise,
                         "noise target of a Monte Carlo reference: each view renders until the "
                         "HDR-FLIP between its two halves (even and odd passes) is at or below it, "
-                        "at most --reference-spp paths per pixel (default then 512); 0, or "
-                        "--reference-spp given alone: a fixed --reference-spp (two halves of "
-                        "spp/2, seeds 2s+1 and 2s+2)")
+                        "at most --reference-spp paths per pixel (default then " +
+                            std::to_string(kDefaultReferenceCap) +
+                            "); 0, or "
+                            "--reference-spp given alone: a fixed --reference-spp (two halves of "
+                            "spp/2, seeds 2s+1 and 2s+2)")
             ->capture_default_str();
     o->spp_flag = cmd->add_option("--reference-spp", o->reference_spp,
                                   "paths per pixel of a Monte Carlo reference: alone, a fixed "
-                                  "count (two halves of spp/2); with --reference-noise, the cap")
+                                  "count (two halves of spp/2; default below); with "
+                                  "--reference-noise, the cap. Effective cap when neither is "
+                                  "given (the default noise target): " +
+                                      std::to_string(kDefaultReferenceCap))
                       ->capture_default_str();
     o->seed_flag = cmd->add_option("--reference-seed", o->reference_seed,
                                    "random seed s of a Monte Carlo reference, in [0, 4294967295]")

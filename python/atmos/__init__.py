@@ -27,7 +27,7 @@ from ._sun import sun_position
 __all__ = [
     "Atmosphere", "Model", "FlipResult", "RmseResult", "models", "model_info", "views",
     "view_names", "atmosphere_presets", "flip", "rmse", "bake", "read_image", "write_image",
-    "set_threads", "thread_count", "sun_position",
+    "set_threads", "thread_count", "sun_position", "to_srgb",
 ]
 
 
@@ -67,7 +67,9 @@ def read_image(path):
 
 def write_image(image, path, exposure=1.0):
     """Writes an H x W x 3 (or H x W) array; the format follows the extension
-    (.exr .png .npy .pfm); `exposure` applies to PNG only."""
+    (.exr .png .npy .pfm); `exposure` applies to PNG only. Refuses (ValueError)
+    NaN, infinite or negative values, as the command line never writes them."""
+    _check_image_values(image)
     _atmos.write_image(image, _os.fspath(path), float(exposure))
 
 
@@ -241,14 +243,19 @@ class Model:
         return self._atmosphere
 
     def options(self):
-        """Every option with its value (defaults included), in table order."""
-        return dict(self._m.options())
+        """Every option with its value (defaults included), in table order:
+        integers as int, reals as float, choices and text as str."""
+        return _typed_options(self.info, self._m.options())
 
-    def prepare(self, atmosphere="earth"):
+    def prepare(self, atmosphere="earth", *, cache=True):
         """Precomputes for the atmosphere (an Atmosphere, or anything
-        Atmosphere.load takes). Returns self."""
+        Atmosphere.load takes). Returns self. Models with tables read them from
+        the user's table cache when an entry of the same model, table-shaping
+        options, atmosphere and build exists, and store them there otherwise
+        ($XDG_CACHE_HOME/atmos/tables; cache=False or ATMOS_NO_CACHE=1:
+        neither)."""
         atm = Atmosphere.load(atmosphere)
-        self._m.prepare(atm._json)
+        self._m.prepare(atm._json, bool(cache))
         self._atmosphere = atm
         return self
 
@@ -283,7 +290,7 @@ class Model:
         (then returns (image, variance)); `progress` is a callable
         progress(passes_done, passes) called after each pass, or True for a
         tqdm bar when tqdm is installed."""
-        width, height = size
+        width, height = _check_render_args(view, size)
         callback, bar = _progress_callback(progress)
         try:
             return self._m.render(
@@ -365,3 +372,68 @@ def bake(model, directory, atmosphere="earth", **options):
     m.bake(directory)
     return m
 
+
+
+# --- Issue 33 item 5: argument checks, typed options, the version, a display helper.
+
+__version__ = _atmos.__version__
+
+
+def _check_render_args(view, size):
+    """(width, height) of render()'s size after checking view and size
+    (ValueError with the command line's wording)."""
+    if not isinstance(view, str):
+        raise ValueError(f"view: expected a view name (atmos.view_names()), got "
+                         f"{type(view).__name__}")
+    try:
+        width, height = size
+    except (TypeError, ValueError):
+        raise ValueError(f"size: expected (width, height), each in [1, 16384], got {size!r}") \
+            from None
+    for v in (width, height):
+        if isinstance(v, bool) or not isinstance(v, (int, _np.integer)) or not 1 <= v <= 16384:
+            raise ValueError(f"size: expected (width, height), each an integer in [1, 16384], "
+                             f"got {size!r}")
+    return int(width), int(height)
+
+
+def _typed_options(info, pairs):
+    types = {o["name"]: o["type"] for o in info["options"]}
+    out = {}
+    for name, text in pairs:
+        kind = types.get(name)
+        if kind == "integer":
+            out[name] = int(text)
+        elif kind == "real":
+            out[name] = float(text)
+        else:
+            out[name] = text
+    return out
+
+
+def _check_image_values(image):
+    if isinstance(image, (str, _os.PathLike)):
+        return
+    a = _np.asarray(image)
+    if a.dtype.kind not in "biuf":
+        raise ValueError(f"image: expected numbers, got dtype {a.dtype}")
+    if a.dtype.kind == "f":
+        bad = ~_np.isfinite(a)
+        if bad.any():
+            raise ValueError(f"image: {int(bad.sum())} values are NaN or infinite (first at "
+                             f"index {tuple(int(i) for i in _np.argwhere(bad)[0])})")
+    neg = a < 0
+    if neg.any():
+        raise ValueError(f"image: {int(neg.sum())} values are negative (first at index "
+                         f"{tuple(int(i) for i in _np.argwhere(neg)[0])}); radiance is >= 0")
+
+
+def to_srgb(image, exposure=1.0):
+    """A linear radiance image (H x W x 3) as display values in [0, 1] for
+    plotting (e.g. matplotlib's imshow), the PNG writer's curve: the exposure,
+    the tone map 1 - exp(-x), then the sRGB transfer function (IEC 61966-2-1).
+    Returns float32 of the same shape."""
+    x = _np.asarray(image, dtype=_np.float64) * float(exposure)
+    x = 1.0 - _np.exp(-_np.maximum(_np.nan_to_num(x, nan=0.0, posinf=1e30), 0.0))
+    srgb = _np.where(x < 0.0031308, 12.92 * x, 1.055 * _np.power(x, 1.0 / 2.4) - 0.055)
+    return _np.clip(srgb, 0.0, 1.0).astype(_np.float32)

@@ -27,6 +27,7 @@
 #include "atmos/sun_position.h"
 #include "atmos/view.h"
 #include "base/parallel.h"
+#include "harness/table_cache.h"
 #include "metrics/flip.h"
 #include "metrics/rmse.h"
 #include "render/progressive.h"
@@ -120,7 +121,11 @@ py::array_t<float> ImageArray(Image&& image) {
 Image ArrayImage(const py::array_t<float, py::array::c_style | py::array::forcecast>& a,
                  const char* what) {
     const bool grey = a.ndim() == 2;
-    if (!grey && !(a.ndim() == 3 && a.shape(2) == 3)) {
+    if (a.ndim() == 3 && a.shape(2) != 3) {
+        Fail(what, ": expected an H x W x 3 (or H x W) array, got ", a.shape(0), " x ", a.shape(1),
+             " x ", a.shape(2), ": ", a.shape(2), " channels, not 3");
+    }
+    if (!grey && a.ndim() != 3) {
         Fail(what, ": expected an H x W x 3 (or H x W) array, got ", a.ndim(), " dimensions");
     }
     const int h = static_cast<int>(a.shape(0)), w = static_cast<int>(a.shape(1));
@@ -413,17 +418,23 @@ PYBIND11_MODULE(_atmos, mod) {
              })
         .def(
             "prepare",
-            [](PyModel& m, const std::string& atmosphere_json) {
+            [](PyModel& m, const std::string& atmosphere_json, bool cache) {
                 const AtmosphereParameters a = AtmosphereFromJson(atmosphere_json);
                 m.prepared = false;
+                bool from_cache = false;
                 {
+                    // Through the table cache (harness/table_cache.h; issue 33 item 4).
+                    const std::map<std::string, std::string> given = ParseModelSpec(m.spec).options;
                     py::gil_scoped_release release;
-                    m.model->Prepare(a);
+                    from_cache =
+                        PrepareWithTableCache(m.model.get(), given, a, UserTableCache(!cache))
+                            .from_cache;
                 }
                 m.atmosphere = a;
                 m.prepared = true;
+                return from_cache;
             },
-            py::arg("atmosphere_json"))
+            py::arg("atmosphere_json"), py::arg("cache") = true)
         .def(
             "load_baked",
             [](PyModel& m, const std::string& directory, const std::string& atmosphere_json) {
@@ -562,4 +573,5 @@ PYBIND11_MODULE(_atmos, mod) {
         },
         py::arg("times"), py::arg("latitudes"), py::arg("longitudes"), py::arg("height"),
         py::arg("pressure"), py::arg("temperature"), py::arg("delta_t"), py::arg("refraction"));
+    mod.attr("__version__") = ATMOS_VERSION;  // the CMake project's (python/CMakeLists.txt)
 }

@@ -8,6 +8,10 @@ import subprocess
 
 import pytest
 
+# Hermetic: no test reads or writes the user's table cache (issue 33 item 4);
+# the cache's own tests point XDG_CACHE_HOME at a scratch directory.
+os.environ["ATMOS_NO_CACHE"] = "1"
+
 
 def _cli_path():
     path = os.environ.get("ATMOS_CLI")

@@ -54,8 +54,8 @@ def test_option_errors_carry_the_cli_message(cli):
         atmos.Model("naive", steps=True)
     # Keywords take '_' for '-'; a spec string works as on the command line.
     m = atmos.Model("naive", light_steps=4)
-    assert m.options()["light-steps"] == "4"
-    assert atmos.Model("naive:steps=8").options()["steps"] == "8"
+    assert m.options()["light-steps"] == 4
+    assert atmos.Model("naive:steps=8").options()["steps"] == 8
 
 
 def test_atmosphere_load_fields_and_validation(tmp):
@@ -324,3 +324,66 @@ def test_memory_does_not_grow_over_1000_calls():
     # 1000 calls allocate 1000 x (24 KB of answers + 12 KB image): a leak of any
     # of them would grow by >= 12 MB.
     assert grown < 4 * 1024 * 1024, f"RSS grew by {grown / 1e6:.1f} MB over 1000 calls"
+
+
+# --- Issue 33 item 5 and item 4 (the table cache from Python).
+
+def test_render_arguments_are_checked():
+    m = atmos.Model("naive", steps=4, light_steps=2).prepare()
+    with pytest.raises(ValueError, match="view"):
+        m.render(view={"camera": [0, 0, 1]}, size=(8, 4))
+    with pytest.raises(ValueError, match="size"):
+        m.render(size=16)
+    with pytest.raises(ValueError, match="size"):
+        m.render(size=(8.5, 4))
+
+
+def test_flip_names_the_channel_count():
+    a = np.zeros((4, 4, 3), np.float32)
+    with pytest.raises(ValueError, match="4 channels"):
+        atmos.flip(a, np.zeros((4, 4, 4), np.float32))
+
+
+def test_write_image_refuses_what_the_cli_never_writes(tmp_path):
+    good = np.full((2, 3, 3), 0.5, np.float32)
+    atmos.write_image(good, tmp_path / "ok.exr")
+    for bad, what in ((np.nan, "NaN"), (np.inf, "infinite"), (-1.0, "negative")):
+        img = good.copy()
+        img[1, 2, 0] = bad
+        path = tmp_path / "bad.exr"
+        with pytest.raises(ValueError, match=what):
+            atmos.write_image(img, path)
+        assert not path.exists()
+
+
+def test_version_and_typed_options():
+    assert isinstance(atmos.__version__, str) and atmos.__version__.count(".") == 2
+    o = atmos.Model("bruneton").options()
+    assert isinstance(o["orders"], int)
+    assert isinstance(o["mie-storage"], str)
+    assert isinstance(atmos.Model("hillaire").options()["segment-offset"], float)
+
+
+def test_to_srgb_is_the_png_curve():
+    x = np.array([[[0.0, 0.001, 1.0]]], np.float32)
+    y = atmos.to_srgb(x)
+    assert y.dtype == np.float32 and y.shape == x.shape
+    t = 1.0 - np.exp(-1.0)
+    assert y[0, 0, 0] == 0.0
+    assert abs(y[0, 0, 1] - 12.92 * (1.0 - np.exp(-0.001))) < 1e-6
+    assert abs(y[0, 0, 2] - (1.055 * t ** (1 / 2.4) - 0.055)) < 1e-6
+    assert atmos.to_srgb(x, exposure=2.0)[0, 0, 2] > y[0, 0, 2]
+
+
+def test_prepare_uses_the_table_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setenv("ATMOS_NO_CACHE", "0")
+    m = atmos.Model("hillaire")
+    assert m._m.prepare(atmos.Atmosphere.load("earth")._json, True) is False  # computed, stored
+    assert (tmp_path / "atmos" / "tables").is_dir()
+    again = atmos.Model("hillaire")
+    assert again._m.prepare(atmos.Atmosphere.load("earth")._json, True) is True  # loaded
+    a = m.render(view="ground-sunrise", size=(16, 9))
+    b = again.render(view="ground-sunrise", size=(16, 9))
+    assert a.tobytes() == b.tobytes()
+    assert atmos.Model("hillaire")._m.prepare(atmos.Atmosphere.load("earth")._json, False) is False

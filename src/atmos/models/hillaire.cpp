@@ -5,7 +5,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <sstream>
 #include <utility>
 
@@ -65,12 +64,14 @@ const OptionTable<HillaireOptions>& HillaireModel::OptionRows() {
             .Real("segment-offset", &O::segment_offset, 0, 1, "",
                   "position of the sample inside each march segment (0.5: midpoint; 0.3: the "
                   "paper's demo)")
+            .ShapesTables()  // the multiple-scattering table's march (issue 33 item 4)
             .Choice("ground-path", &O::ground_from_ap,
                     {{"aerial-perspective", true}, {"sky-view", false}},
                     "in-scatter and transmittance of ground rays (camera inside): from the aerial-"
                     "perspective volume or the sky-view table")
             .Choice("sample-path", &O::sample_with_tables, {{"table", true}, {"march", false}},
-                    "sample: sky-view table per (altitude, sun) group, or ray march everything");
+                    "sample: each query through the sky-view table of its altitude and sun (its "
+                    "four texels), or the ray march");
     return table;
 }
 
@@ -222,44 +223,16 @@ std::vector<SampleAnswer> HillaireModel::Sample(const std::vector<SampleQuery>& 
     ResidentScope scope(&resident_);
     scope.Keep(evaluator_);
     if (!sample_with_tables_) return SampleAll(evaluator_, atm.bottom_radius, queries);
-    // Group the queries by (altitude, mu_s): one sky-view table per group.
-    std::map<std::pair<double, double>, std::vector<size_t>> groups;
-    for (size_t q = 0; q < queries.size(); ++q) {
-        groups[{queries[q].altitude_m, queries[q].mu_s}].push_back(q);
-    }
-    // Chosen automatically (issue 18 item 9): a sky-view table costs about as
-    // much as a thousand marched queries, so scattered queries (many groups of
-    // a few queries: 2000 took 307 s through tables, 0.8 s marched) are marched.
-    constexpr size_t kFewGroups = 16, kQueriesPerTable = 256;
-    if (groups.size() > kFewGroups && groups.size() * kQueriesPerTable > queries.size()) {
-        return SampleAll(evaluator_, atm.bottom_radius, queries);
-    }
-    std::vector<SampleAnswer> answers(queries.size());
-    // On a device backend the model's tables stay on the device for all
-    // groups; each group's sky-view table is resized in place (its old device
-    // copy is dropped) and its queries go through the one launch (SampleAll)
-    // with that table, which the device already holds.
-    StageSession session;
-    Table sky_view;
-    std::vector<SampleQuery> group_queries;
-    // One bar for every group (a sky-view table and its queries each).
-    Progress progress("sample", static_cast<int64_t>(queries.size()), LibraryProgressEnabled());
-    for (const auto& group : groups) {
-        const double r = atm.bottom_radius + group.first.first;
-        HillaireEvaluator e = evaluator_;
-        if (r <= atm.top_radius) {
-            BuildSkyView(r, ClampCosine(group.first.second), &sky_view);
-            session.Download(&sky_view);
-            e.sky_view = sky_view.view();
-        }
-        const std::vector<size_t>& members = group.second;
-        group_queries.clear();
-        for (size_t q : members) group_queries.push_back(queries[q]);
-        const std::vector<SampleAnswer> group_answers =
-            SampleAll(e, atm.bottom_radius, group_queries, &progress);
-        for (size_t k = 0; k < members.size(); ++k) answers[members[k]] = group_answers[k];
-    }
-    return answers;
+    // The table path (issue 33 item 1): each query reads the sky-view table of
+    // its own camera and sun, computing only the four texels its lookup reads
+    // (HillaireEvaluator::SkyView), so that its answer is the one a render's
+    // frame table gives and does not depend on the other queries of the batch.
+    // (It replaced one full table per (altitude, mu_s) group with an automatic
+    // switch to the march for scattered queries, which made an answer depend
+    // on the batch.) Cost: 4 x sky-view-steps march steps per query.
+    HillaireEvaluator e = evaluator_;
+    e.per_query_sky_view_steps = sky_view_steps_;
+    return SampleAll(e, atm.bottom_radius, queries);
 }
 
 // --- Bake -----------------------------------------------------------------

@@ -232,6 +232,11 @@ struct HillaireEvaluator {
     bool use_multiple_scattering = true;  // false: single scattering only (tests)
     double segment_offset = 0.3;          // sample position inside each march segment
     bool ground_from_ap = true;  // ground rays: aerial perspective (true) or sky-view table
+    // > 0 and no sky-view table (sample-path=table): each lookup computes the
+    // sky-view texels it reads, with this many steps each, for its own camera
+    // and sun (SkyView): the same bits as the frame table a render at that
+    // camera and sun would build, whatever the other queries of the batch.
+    int per_query_sky_view_steps = 0;
 
     // Per-frame tables (data == nullptr: absent).
     TableView sky_view;          // 192 x 108, RGB
@@ -343,7 +348,54 @@ struct HillaireEvaluator {
         const double cos_az = lh > 1e-12 ? ClampCosine(Dot(dir_h, sun_h) / lh) : 1.0;
         double u, v;
         HillaireSkyViewUv(r, atm.bottom_radius, mu_v, cos_az, &u, &v);
-        return Vec3d(SampleBilinearRgb(sky_view, u, v));
+        if (sky_view.data != nullptr) return Vec3d(SampleBilinearRgb(sky_view, u, v));
+        // No table: the four texels of this lookup, computed here exactly as
+        // HillaireSkyViewStage computes them for the frame of this camera and
+        // sun (HillaireModel::BuildFrame), then the same bilinear blend on a
+        // 2 x 2 table (same operations, same bits).
+        const TexelSpan sx = SplitSpan(u, kHillaireSkyViewWidth);
+        const TexelSpan sy = SplitSpan(v, kHillaireSkyViewHeight);
+        const double mu_s = ClampCosine(Dot(sun, camera) / r);
+        const Vec3d sun_xz(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
+        const double r_table = Max(r, atm.bottom_radius + kHillaireSkyViewMinAltitude);
+        float texels[2 * 2 * 3];
+        for (int row = 0; row < 2; ++row) {
+            for (int col = 0; col < 2; ++col) {
+                const int i = col == 0 ? sx.i0 : sx.i1, j = row == 0 ? sy.i0 : sy.i1;
+                const Vec3d L = (col == 1 && sx.i1 == sx.i0) || (row == 1 && sy.i1 == sy.i0)
+                                    ? Vec3d(0.0)  // not read (the span's weight is on i0)
+                                    : SkyViewTexel(r_table, sun_xz, per_query_sky_view_steps, i, j);
+                float* t = texels + (row * 2 + col) * 3;
+                for (int c = 0; c < 3; ++c) t[c] = static_cast<float>(L[c]);
+            }
+        }
+        TexelSpan x2 = sx, y2 = sy;
+        x2.i0 = 0;
+        x2.i1 = sx.i1 == sx.i0 ? 0 : 1;
+        y2.i0 = 0;
+        y2.i1 = sy.i1 == sy.i0 ? 0 : 1;
+        float o[3];
+        SampleBilinearFixed<3>(texels, 2, x2, y2, o);
+        return Vec3d(Rgb(o[0], o[1], o[2]));
+    }
+
+    // Sky-view texel (i, j) for a camera at radius r (raised to
+    // kHillaireSkyViewMinAltitude) on the z axis and the sun `sun` in the x-z
+    // plane: one ray march of `march_steps` segments (paper section 5.3, Eq. 11),
+    // without ground reflection. Reads only the model's two tables.
+    ATMOS_HD Vec3d SkyViewTexel(double r, const Vec3d& sun, int march_steps, int i, int j) const {
+        const Vec3d camera(0.0, 0.0, r);
+        double mu_v, cos_az;
+        HillaireSkyViewParams(
+            r, atm.bottom_radius, static_cast<double>(i) / (kHillaireSkyViewWidth - 1),
+            static_cast<double>(j) / (kHillaireSkyViewHeight - 1), &mu_v, &cos_az);
+        const double sin_v = SafeSqrt(1.0 - mu_v * mu_v);
+        const Vec3d dir(sin_v * cos_az, sin_v * SafeSqrt(1.0 - cos_az * cos_az), mu_v);
+        const AtmosphereSegment seg =
+            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
+        Vec3d L, T(1.0);
+        if (seg.inside) Integrate(camera, dir, sun, seg.t_start, seg.t_end, march_steps, &L, &T);
+        return L;
     }
 
     // Aerial perspective to distance d along dir; false when dir is outside the
@@ -395,7 +447,7 @@ struct HillaireEvaluator {
         }
         const double r = Length(camera);
         Vec3d L, T(1.0);
-        if (sky_view.data != nullptr && r <= atm.top_radius) {
+        if ((sky_view.data != nullptr || per_query_sky_view_steps > 0) && r <= atm.top_radius) {
             const double mu = ClampCosine(Dot(dir, camera) / r);
             if (!seg.hits_ground) {
                 L = SkyView(camera, dir, sun);

@@ -148,21 +148,9 @@ struct HillaireSkyViewStage {
         v(out);
     }
     ATMOS_HD void operator()(int64_t item) const {
-        const AtmosphereParameters& atm = e.atm;
         const int i = static_cast<int>(item % kHillaireSkyViewWidth);
         const int j = static_cast<int>(item / kHillaireSkyViewWidth);
-        const Vec3d camera(0.0, 0.0, r);
-        double mu_v, cos_az;
-        HillaireSkyViewParams(
-            r, atm.bottom_radius, static_cast<double>(i) / (kHillaireSkyViewWidth - 1),
-            static_cast<double>(j) / (kHillaireSkyViewHeight - 1), &mu_v, &cos_az);
-        const double sin_v = SafeSqrt(1.0 - mu_v * mu_v);
-        const Vec3d dir(sin_v * cos_az, sin_v * SafeSqrt(1.0 - cos_az * cos_az), mu_v);
-        const AtmosphereSegment seg =
-            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
-        Vec3d L, T(1.0);
-        if (seg.inside) e.Integrate(camera, dir, sun, seg.t_start, seg.t_end, steps, &L, &T);
-        out.Set(i, j, 0, HillaireTexel(L));
+        out.Set(i, j, 0, HillaireTexel(e.SkyViewTexel(r, sun, steps, i, j)));
     }
 };
 ATMOS_DEVICE_STAGE(HillaireSkyViewStage)

@@ -16,6 +16,8 @@
 // Model are in models/evaluator_model.h.
 #pragma once
 
+#include <string.h>
+
 #include <cstdint>
 #include <typeinfo>
 #include <vector>
@@ -27,6 +29,7 @@
 #include "base/library_progress.h"
 #include "base/parallel.h"
 #include "base/progress.h"
+#include "base/rng.h"
 #include "physics/geometry.h"
 #include "physics/ray.h"
 #include "render/stages.h"
@@ -62,6 +65,21 @@ ATMOS_HD inline Rgb ShadePixel(const Evaluator& evaluator, const PixelSetup& s, 
         radiance += s.irradiance * r.transmittance * s.sun_disc_scale;
     }
     return radiance;  // RenderImage's output guard follows (GuardOutput)
+}
+
+// The key of a query's random numbers (Monte Carlo evaluators): a hash of
+// the query itself, not of its place in the batch, so that a query's answer
+// does not depend on the batch's size, order or other queries (issue 33);
+// -0.0 counts as 0.0.
+ATMOS_HD inline uint64_t SampleQueryKey(const SampleQuery& q) {
+    const double fields[4] = {q.altitude_m + 0.0, q.mu + 0.0, q.mu_s + 0.0, q.azimuth_deg + 0.0};
+    uint64_t key = 0x5A4D504C45ull;  // "SAMPLE"
+    for (double f : fields) {
+        uint64_t bits;
+        memcpy(&bits, &f, sizeof(bits));
+        key = Mix64(key ^ bits);
+    }
+    return key;
 }
 
 // The sample contract of DESIGN.md for one query, through an evaluator.
@@ -141,7 +159,7 @@ struct SampleStage {
     ATMOS_HD void operator()(int64_t item) const {
         const SampleQuery* q = reinterpret_cast<const SampleQuery*>(queries.data);
         SampleAnswer* a = reinterpret_cast<SampleAnswer*>(answers.data);
-        a[item] = SampleOne(evaluator, bottom_radius, q[item], static_cast<uint64_t>(item));
+        a[item] = SampleOne(evaluator, bottom_radius, q[item], SampleQueryKey(q[item]));
     }
 };
 // Every evaluator but host-only ones (physics/ray.h) has both launches on the
