@@ -52,6 +52,18 @@ double Seconds(std::chrono::steady_clock::time_point since);
 // --load; returns the seconds it took.
 double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphere, Model* model);
 
+// The flags the studies (compare, bench, validate; studies/) share, declared once:
+// --atmosphere, --set, --threads, and --quiet / --backend where the study has them.
+// The caller sets the defaults in the struct before adding the flags.
+struct StudyFlags {
+    std::string atmosphere = "earth";
+    std::vector<std::string> sets;
+    int threads = 0;
+    std::string backend = "cpu";
+    bool quiet = false;
+};
+void AddStudyFlags(CLI::App* cmd, StudyFlags* flags, bool backend, const char* quiet_help);
+
 // --wavelengths, --colour, --white (render, sample, compare, bench): a spectral run
 // (harness/spectral_run.h) when `wavelengths` is not empty.
 struct SpectralFlags {
