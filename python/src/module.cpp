@@ -33,6 +33,7 @@
 namespace py = pybind11;
 
 namespace atmos {
+void BindStudies(py::module_& mod);  // python/src/studies.cpp: validate, compare, bench
 namespace {
 
 const char* OptionTypeName(ModelOptionSpec::Type t) {
@@ -514,4 +515,5 @@ PYBIND11_MODULE(_atmos, mod) {
         },
         py::arg("threads"));
     mod.def("thread_count", &ParallelThreadCount);
+    BindStudies(mod);
 }

@@ -529,12 +529,10 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
     auto item = [&](const std::string& k, const std::string& v) {
         f << "<dt>" << HtmlEscape(k) << "</dt><dd>" << HtmlEscape(v) << "</dd>\n";
     };
-    std::string ref_opts;
-    for (const auto& [k, v] : config.reference_options) {
-        ref_opts += (ref_opts.empty() ? "" : " ") + std::string("--") + k + " " + v;
-    }
+    std::string ref_opts;  // as a model spec: NAME:OPTION=VALUE:...
+    for (const auto& [k, v] : config.reference_options) ref_opts += ":" + k + "=" + v;
     item("reference",
-         config.reference_model + (ref_opts.empty() ? "" : " " + ref_opts) +
+         config.reference_model + ref_opts +
              (config.reference_note.empty() ? "" : " (" + config.reference_note + ")"));
     item("quantity", QuantityName(config.quantity));
     item("size", std::to_string(config.width) + "x" + std::to_string(config.height));
