@@ -50,15 +50,6 @@ void AddBackendOption(CLI::App* cmd, std::string* backend) {
         ->capture_default_str();
 }
 
-void RequireQuantity(const ModelInfo& info, Quantity quantity) {
-    const bool produces = quantity == Quantity::kRadiance ? info.capabilities.radiance
-                                                          : info.capabilities.transmittance;
-    if (!produces) {
-        Fail("model ", info.name, " does not produce ", QuantityName(quantity), " (it produces ",
-             info.capabilities.radiance ? "radiance" : "transmittance", " only)");
-    }
-}
-
 ModelSpec GivenModel(const CommonOptions& o) { return ParseModelSpec(o.model); }
 
 // "WxH" with 1 <= W, H <= 16384.

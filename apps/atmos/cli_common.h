@@ -16,6 +16,7 @@
 #include "atmos/model.h"
 #include "atmos/view.h"
 #include "harness/spectral_run.h"
+#include "studies/common.h"  // RequireQuantity
 
 namespace atmos::cli {
 
@@ -35,9 +36,6 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o);
 // --strict was given: output values the output guard replaced (NaN, infinity,
 // negative; OutputGuardCount()) fail the command instead of a warning.
 bool StrictRequested();
-// Fails (one clear line, exit 2) when the model does not produce the quantity
-// (a transmittance model asked for radiance, preetham for transmittance).
-void RequireQuantity(const ModelInfo& info, Quantity quantity);
 // --backend cpu|cuda: where the per-pixel loops run (render, sample, compare,
 // bench). The command selects it with a BackendScope (base/parallel.h), which
 // fails with one clear error when CUDA is not built in or no device is present.

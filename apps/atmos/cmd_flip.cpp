@@ -95,10 +95,7 @@ Command AddFlipCommand(CLI::App* root) {
     o->stop_flag = cmd->add_option("--stop-exposure", o->stop, "HDR stop exposure (log2)");
     cmd->add_option("--num-exposures", o->exposures, "HDR number of exposures")
         ->check(CLI::Range(0, 1000));
-    Command c;
-    c.app = cmd;
-    c.run = [o] { return CmdFlip(*o); };
-    return c;
+    return {cmd, [o] { return CmdFlip(*o); }};
 }
 
 }  // namespace atmos::cli

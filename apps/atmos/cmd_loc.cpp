@@ -63,10 +63,7 @@ Command AddLocCommand(CLI::App* root) {
         ->allow_extra_args(false);
     cmd->add_option("--source", o->source, "repository root holding src/atmos/models")
         ->capture_default_str();
-    Command c;
-    c.app = cmd;
-    c.run = [o] { return CmdLoc(*o); };
-    return c;
+    return {cmd, [o] { return CmdLoc(*o); }};
 }
 
 }  // namespace atmos::cli

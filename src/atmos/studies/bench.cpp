@@ -15,6 +15,7 @@
 #include "base/parallel.h"
 #include "harness/machine.h"
 #include "render/stages.h"
+#include "studies/common.h"
 
 namespace atmos {
 
@@ -163,13 +164,7 @@ BenchConfig ResolveBenchConfig(BenchConfig c) {
     bool any_monte_carlo = false;
     for (const std::string& m : c.models) {
         const ModelInfo info = GetModelInfo(ParseModelSpec(m).name);
-        const bool produces = quantity == Quantity::kRadiance ? info.capabilities.radiance
-                                                              : info.capabilities.transmittance;
-        if (!produces) {
-            Fail("model ", info.name, " does not produce ", QuantityName(quantity),
-                 " (it produces ", info.capabilities.radiance ? "radiance" : "transmittance",
-                 " only)");
-        }
+        RequireQuantity(info, quantity);
         any_monte_carlo = any_monte_carlo || info.capabilities.stochastic;
     }
     if (c.monte_carlo_given && !any_monte_carlo) {
