@@ -1,5 +1,5 @@
-// atmos CLI: `atmos loc`: significant lines of code per model (seed 003 section
-// 11.7; rules in src/atmos/harness/loc.h), next to the thesis's counts.
+// atmos CLI: `atmos loc`: significant lines of code per model (Leenman 2025, the
+// thesis, section 11.7; rules in src/atmos/harness/loc.h), next to the thesis's counts.
 #include <cstdio>
 #include <filesystem>
 #include <memory>
