@@ -39,20 +39,22 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
                   "ATMOS_NO_CACHE=1; size limit ATMOS_CACHE_MAX_MB, default 2048)");
 }
 
+void AddStudyFlags(CLI::App* cmd, StudyFlags* flags, bool backend, const char* quiet_help) {
+    cmd->add_option("--atmosphere,-a", flags->atmosphere, "preset name or JSON file")
+        ->capture_default_str();
+    cmd->add_option("--set", flags->sets, "override one atmosphere field: FIELD=VALUE (repeatable)")
+        ->allow_extra_args(false);
+    cmd->add_option("--threads", flags->threads, "worker threads (0: all cores)")
+        ->check(CLI::Range(0, 4096));  // (NonNegativeNumber printed a 309-digit bound)
+    if (quiet_help) cmd->add_flag("--quiet,-q", flags->quiet, quiet_help);
+    if (backend) AddBackendOption(cmd, &flags->backend);
+}
+
 void AddBackendOption(CLI::App* cmd, std::string* backend) {
     cmd->add_option("--backend", *backend,
                     "where pixels are computed: cpu, or cuda (a build with -DATMOS_CUDA=ON and a "
                     "CUDA device)")
         ->capture_default_str();
-}
-
-void RequireQuantity(const ModelInfo& info, Quantity quantity) {
-    const bool produces = quantity == Quantity::kRadiance ? info.capabilities.radiance
-                                                          : info.capabilities.transmittance;
-    if (!produces) {
-        Fail("model ", info.name, " does not produce ", QuantityName(quantity), " (it produces ",
-             info.capabilities.radiance ? "radiance" : "transmittance", " only)");
-    }
 }
 
 ModelSpec GivenModel(const CommonOptions& o) { return ParseModelSpec(o.model); }

@@ -16,6 +16,7 @@
 #include "atmos/model.h"
 #include "atmos/view.h"
 #include "harness/spectral_run.h"
+#include "studies/common.h"  // RequireQuantity
 
 namespace atmos::cli {
 
@@ -36,9 +37,6 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o);
 // --strict was given: output values the output guard replaced (NaN, infinity,
 // negative; OutputGuardCount()) fail the command instead of a warning.
 bool StrictRequested();
-// Fails (one clear line, exit 2) when the model does not produce the quantity
-// (a transmittance model asked for radiance, preetham for transmittance).
-void RequireQuantity(const ModelInfo& info, Quantity quantity);
 // --backend cpu|cuda: where the per-pixel loops run (render, sample, compare,
 // bench). The command selects it with a BackendScope (base/parallel.h), which
 // fails with one clear error when CUDA is not built in or no device is present.
@@ -52,6 +50,18 @@ double Seconds(std::chrono::steady_clock::time_point since);
 // Prepare()s the model for the atmosphere, or loads its baked tables with
 // --load; returns the seconds it took.
 double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphere, Model* model);
+
+// The flags the studies (compare, bench, validate; studies/) share, declared once:
+// --atmosphere, --set, --threads, and --quiet / --backend where the study has them.
+// The caller sets the defaults in the struct before adding the flags.
+struct StudyFlags {
+    std::string atmosphere = "earth";
+    std::vector<std::string> sets;
+    int threads = 0;
+    std::string backend = "cpu";
+    bool quiet = false;
+};
+void AddStudyFlags(CLI::App* cmd, StudyFlags* flags, bool backend, const char* quiet_help);
 
 // --wavelengths, --colour, --white (render, sample, compare, bench): a spectral run
 // (harness/spectral_run.h) when `wavelengths` is not empty.

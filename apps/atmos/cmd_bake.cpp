@@ -20,6 +20,7 @@
 #include "cli_common.h"
 #include "embedded_assets.h"
 #include "io/output_path.h"
+#include "io/text_files.h"
 
 namespace atmos::cli {
 
@@ -42,14 +43,6 @@ constexpr const char* kCommonShader = "shaders/common.glsl";
 
 void WriteText(const fs::path& path, const std::string& text) {
     WriteFileAtomically(path.string(), text);
-}
-
-std::string ReadFile(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) Fail("cannot read '", path.string(), "'");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
 }
 
 // Precomputes (or --load's) `common`'s model and bakes it into `dir`, shaders
@@ -77,77 +70,27 @@ std::string BakeInto(const CommonOptions& common, const std::string& dir) {
     return spec.name;
 }
 
-// A JavaScript string literal of `text`.
-std::string JsString(const std::string& text) {
-    std::string out = "\"";
-    for (const char c : text) {
-        switch (c) {
-            case '"':
-                out += "\\\"";
-                break;
-            case '\\':
-                out += "\\\\";
-                break;
-            case '\n':
-                out += "\\n";
-                break;
-            case '\r':
-                break;
-            case '<':
-                out += "\\x3c";
-                break;  // no "</script>" in a script
-            default:
-                out += c;
-        }
-    }
-    return out + "\"";
-}
-
-std::string Base64(const std::string& bytes) {
-    static const char* kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    out.reserve((bytes.size() + 2) / 3 * 4);
-    size_t i = 0;
-    for (; i + 2 < bytes.size(); i += 3) {
-        const unsigned v = (static_cast<unsigned char>(bytes[i]) << 16) |
-                           (static_cast<unsigned char>(bytes[i + 1]) << 8) |
-                           static_cast<unsigned char>(bytes[i + 2]);
-        out += kDigits[(v >> 18) & 63];
-        out += kDigits[(v >> 12) & 63];
-        out += kDigits[(v >> 6) & 63];
-        out += kDigits[v & 63];
-    }
-    if (i < bytes.size()) {
-        unsigned v = static_cast<unsigned char>(bytes[i]) << 16;
-        if (i + 1 < bytes.size()) v |= static_cast<unsigned char>(bytes[i + 1]) << 8;
-        out += kDigits[(v >> 18) & 63];
-        out += kDigits[(v >> 12) & 63];
-        out += i + 1 < bytes.size() ? kDigits[(v >> 6) & 63] : '=';
-        out += '=';
-    }
-    return out;
-}
-
 // The page's view of one baked model: MODEL/model.js (its JSON, constants and
 // functions: common.glsl then the model's shader)
 // and MODEL/tables_f32.js, MODEL/tables_f16.js (the raw blobs in base64):
 // scripts, so that the page works from file:// where fetch() is refused.
 void WriteViewerData(const fs::path& dir, const std::string& name) {
-    const std::string json = ReadFile(dir / (name + ".json"));
-    const std::string functions = ReadFile(dir / kCommonShader) + ReadFile(dir / ShaderAsset(name));
+    const std::string json = ReadWholeFile(dir / (name + ".json"));
+    const std::string functions =
+        ReadWholeFile(dir / kCommonShader) + ReadWholeFile(dir / ShaderAsset(name));
     std::string file = name;
     for (char& c : file) {
         if (c == '-') c = '_';
     }
-    const std::string constants = ReadFile(dir / "shaders" / (file + "_constants.glsl"));
-    WriteText(dir / "model.js", "atmosViewerData.models[" + JsString(name) + "] = {bake: " + json +
-                                    ", constants: " + JsString(constants) +
-                                    ", functions: " + JsString(functions) + "};\n");
+    const std::string constants = ReadWholeFile(dir / "shaders" / (file + "_constants.glsl"));
+    WriteText(dir / "model.js", "atmosViewerData.models[" + JsStringLiteral(name) + "] = {bake: " +
+                                    json + ", constants: " + JsStringLiteral(constants) +
+                                    ", functions: " + JsStringLiteral(functions) + "};\n");
     for (const char* format : {"f32", "f16"}) {
-        const std::string blob = ReadFile(dir / (std::string("tables.") + format));
+        const std::string blob = ReadWholeFile(dir / (std::string("tables.") + format));
         WriteText(dir / (std::string("tables_") + format + ".js"),
-                  "atmosViewerData.tables[" + JsString(name + "/" + format) + "] = \"" +
-                      Base64(blob) + "\";\n");
+                  "atmosViewerData.tables[" + JsStringLiteral(name + "/" + format) + "] = \"" +
+                      Base64Encode(blob) + "\";\n");
     }
 }
 
@@ -271,7 +214,7 @@ Command AddViewerCommand(CLI::App* root) {
             const std::string name = ParseModelSpec(spec).name;
             BakeInto(one, (dir / name).string());
             WriteViewerData(dir / name, name);
-            list += (list.empty() ? "" : ", ") + JsString(name);
+            list += (list.empty() ? "" : ", ") + JsStringLiteral(name);
         }
         WriteText(dir / "index.html", FindAsset("viewer/index.html"));
         WriteText(dir / "viewer.js", FindAsset("viewer/viewer.js"));

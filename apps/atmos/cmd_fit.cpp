@@ -24,13 +24,10 @@ namespace {
 
 struct FitOptions {
     std::string model = "neural";
-    std::string atmosphere = "earth";
-    std::vector<std::string> sets;
+    StudyFlags study;  // --atmosphere, --set, --threads, --quiet
     std::string reference = "bruneton";
     int64_t reference_spp = 64;
     std::string output;
-    int threads = 0;
-    bool quiet = false;
     NeuralFitOptions fit;
 };
 
@@ -40,11 +37,11 @@ int CmdFit(const FitOptions& o) {
     if (o.output.empty()) Fail("fit: -o FILE.json is required");
     CheckOutputFile(o.output);     // before the fit (io/output_path.h)
     CheckNeuralFitOptions(o.fit);  // before the reference's precomputation
-    ThreadLimit limit(o.threads);
+    ThreadLimit limit(o.study.threads);
     // Progress bars (the reference's precomputation and samples, the training)
     // on a terminal for work over a second, unless --quiet.
-    const LibraryProgressScope progress(!o.quiet);
-    const AtmosphereParameters atmosphere = LoadAtmosphere(o.atmosphere, o.sets);
+    const LibraryProgressScope progress(!o.study.quiet);
+    const AtmosphereParameters atmosphere = LoadAtmosphere(o.study.atmosphere, o.study.sets);
     const ModelSpec spec = ParseModelSpec(o.reference);
     if (spec.name == o.model) Fail("fit: --reference cannot be the model being fitted");
     std::unique_ptr<Model> reference = CreateModel(spec);
@@ -68,13 +65,13 @@ int CmdFit(const FitOptions& o) {
     {
         std::string t = w.training_json;
         const std::string extra =
-            "\"reference\":\"" + o.reference + "\",\"atmosphere\":\"" + o.atmosphere + "\",";
+            "\"reference\":\"" + o.reference + "\",\"atmosphere\":\"" + o.study.atmosphere + "\",";
         if (t.size() >= 2 && t.front() == '{') t.insert(1, extra);
         w.training_json = t;
     }
     const std::string text = NeuralWeightsToJson(w);
     WriteFileAtomically(o.output, text);
-    if (!o.quiet) {
+    if (!o.study.quiet) {
         auto line = [](const char* name, const NeuralNetFitReport& r) {
             std::printf(
                 "%-13s loss %.5g -> %.5g; RMS ln-error train %.4f, held-out %.4f; held-out mean "
@@ -95,65 +92,52 @@ int CmdFit(const FitOptions& o) {
 
 Command AddFitCommand(CLI::App* root) {
     auto o = std::make_shared<FitOptions>();
-    Command c;
-    c.app = root->add_subcommand(
+    CLI::App* cmd = root->add_subcommand(
         "fit", "fit the neural model's networks to a reference model; write the weights as JSON");
-    c.app->add_option("--model", o->model, "model to fit (neural)")->capture_default_str();
-    c.app->add_option("--atmosphere", o->atmosphere, "preset name or JSON file")
+    cmd->add_option("--model", o->model, "model to fit (neural)")->capture_default_str();
+    AddStudyFlags(cmd, &o->study, false, "print nothing");
+    cmd->add_option("--reference", o->reference,
+                    "model sampled for the training data, NAME[:OPTION=VALUE...]: bruneton "
+                    "(fast) or reference (path tracer)")
         ->capture_default_str();
-    c.app->add_option("--set", o->sets, "override an atmosphere field: FIELD=VALUE");
-    c.app
-        ->add_option("--reference", o->reference,
-                     "model sampled for the training data, NAME[:OPTION=VALUE...]: bruneton "
-                     "(fast) or reference (path tracer)")
+    cmd->add_option("--reference-spp", o->reference_spp,
+                    "paths per query of a Monte Carlo reference (the path tracer)")
         ->capture_default_str();
-    c.app
-        ->add_option("--reference-spp", o->reference_spp,
-                     "paths per query of a Monte Carlo reference (the path tracer)")
+    cmd->add_option("--network", o->fit.network,
+                    "thesis (4-8-8-3 scattering) or large (8-32-32-3, horizon inputs)")
         ->capture_default_str();
-    c.app
-        ->add_option("--network", o->fit.network,
-                     "thesis (4-8-8-3 scattering) or large (8-32-32-3, horizon inputs)")
-        ->capture_default_str();
-    c.app->add_option("--encoding", o->fit.encoding,
-                      "scattering inputs: thesis | extended | horizon (default: the network's "
-                      "own; large: horizon, extended: before issue 15)");
-    c.app->add_option_function<double>(
+    cmd->add_option("--encoding", o->fit.encoding,
+                    "scattering inputs: thesis | extended | horizon (default: the network's "
+                    "own; large: horizon, extended: before issue 15)");
+    cmd->add_option_function<double>(
         "--horizon-fraction", [o](const double& v) { o->fit.horizon_fraction = v; },
         "fraction of scattering samples viewing near the horizon (default: thesis "
         "0, large 0.25)");
-    c.app->add_option_function<double>(
+    cmd->add_option_function<double>(
         "--loss-epsilon", [o](const double& v) { o->fit.loss_epsilon = v; },
         "eps of the scattering loss ln((y_hat + eps) / (y + eps)) (default: "
         "thesis 1e-4, large 1e-6)");
-    c.app->add_option("--transmittance-samples", o->fit.transmittance_samples)
+    cmd->add_option("--transmittance-samples", o->fit.transmittance_samples)->capture_default_str();
+    cmd->add_option("--scattering-samples", o->fit.scattering_samples)->capture_default_str();
+    cmd->add_option("--transmittance-iterations", o->fit.transmittance_steps,
+                    "Adam iterations of the transmittance network")
         ->capture_default_str();
-    c.app->add_option("--scattering-samples", o->fit.scattering_samples)->capture_default_str();
-    c.app
-        ->add_option("--transmittance-iterations", o->fit.transmittance_steps,
-                     "Adam iterations of the transmittance network")
+    cmd->add_option("--scattering-iterations", o->fit.scattering_steps,
+                    "Adam iterations of the scattering network")
         ->capture_default_str();
-    c.app
-        ->add_option("--scattering-iterations", o->fit.scattering_steps,
-                     "Adam iterations of the scattering network")
+    cmd->add_option("--batch", o->fit.batch, "mini-batch size")->capture_default_str();
+    cmd->add_option("--learning-rate", o->fit.learning_rate, "Adam step size")
         ->capture_default_str();
-    c.app->add_option("--batch", o->fit.batch, "mini-batch size")->capture_default_str();
-    c.app->add_option("--learning-rate", o->fit.learning_rate, "Adam step size")
+    cmd->add_option("--final-learning-rate", o->fit.final_learning_rate,
+                    "the scattering network's step size at its last iteration (exponential "
+                    "decay; equal to --learning-rate: constant, as the thesis)")
         ->capture_default_str();
-    c.app
-        ->add_option("--final-learning-rate", o->fit.final_learning_rate,
-                     "the scattering network's step size at its last iteration (exponential "
-                     "decay; equal to --learning-rate: constant, as the thesis)")
+    cmd->add_option("--holdout", o->fit.holdout, "fraction of samples held out")
         ->capture_default_str();
-    c.app->add_option("--holdout", o->fit.holdout, "fraction of samples held out")
+    cmd->add_option("--seed", o->fit.seed, "seed of sampling, initialisation, batches")
         ->capture_default_str();
-    c.app->add_option("--seed", o->fit.seed, "seed of sampling, initialisation, batches")
-        ->capture_default_str();
-    c.app->add_option("-o,--output", o->output, "weights JSON to write")->required();
-    c.app->add_option("--threads", o->threads, "threads (0: all)")->capture_default_str();
-    c.app->add_flag("--quiet", o->quiet, "print nothing");
-    c.run = [o] { return CmdFit(*o); };
-    return c;
+    cmd->add_option("-o,--output", o->output, "weights JSON to write")->required();
+    return {cmd, [o] { return CmdFit(*o); }};
 }
 
 }  // namespace atmos::cli

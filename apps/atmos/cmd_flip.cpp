@@ -87,7 +87,7 @@ Command AddFlipCommand(CLI::App* root) {
         ->capture_default_str();
     cmd->add_option("--exposure", o->exposure,
                     "HDR black pixels: atmos (exposure median over the non-black pixels) or thesis "
-                    "(seed 003 section 11.5: 1e-9 added to every pixel, median over all)")
+                    "(Leenman 2025 section 11.5: 1e-9 added to every pixel, median over all)")
         ->capture_default_str();
     cmd->add_option("--mode", o->mode, "auto (PNG reference: LDR), ldr or hdr")
         ->capture_default_str();
@@ -95,10 +95,7 @@ Command AddFlipCommand(CLI::App* root) {
     o->stop_flag = cmd->add_option("--stop-exposure", o->stop, "HDR stop exposure (log2)");
     cmd->add_option("--num-exposures", o->exposures, "HDR number of exposures")
         ->check(CLI::Range(0, 1000));
-    Command c;
-    c.app = cmd;
-    c.run = [o] { return CmdFlip(*o); };
-    return c;
+    return {cmd, [o] { return CmdFlip(*o); }};
 }
 
 }  // namespace atmos::cli

@@ -1,5 +1,5 @@
-// atmos CLI: `atmos loc`: significant lines of code per model (seed 003 section
-// 11.7; rules in src/atmos/harness/loc.h), next to the thesis's counts.
+// atmos CLI: `atmos loc`: significant lines of code per model (Leenman 2025, the
+// thesis, section 11.7; rules in src/atmos/harness/loc.h), next to the thesis's counts.
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -63,10 +63,7 @@ Command AddLocCommand(CLI::App* root) {
         ->allow_extra_args(false);
     cmd->add_option("--source", o->source, "repository root holding src/atmos/models")
         ->capture_default_str();
-    Command c;
-    c.app = cmd;
-    c.run = [o] { return CmdLoc(*o); };
-    return c;
+    return {cmd, [o] { return CmdLoc(*o); }};
 }
 
 }  // namespace atmos::cli

@@ -3,7 +3,6 @@
 // checked against a directory of shipped references (which views to render),
 // or recorded into its provenance.json.
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -64,28 +63,16 @@ int CmdReferenceProvenance(const ProvenanceOptions& o) {
     // --check: the views whose shipped image does not stand for this render.
     if (!(o.noise >= 0.0 && o.noise < 1.0)) Fail("--noise must be in [0, 1), got ", o.noise);
     if (o.cap < 1) Fail("--check needs --cap N (paths per pixel, >= 1)");
-    std::unique_ptr<ShippedReferences> shipped;
-    std::string unusable = "no provenance";
-    if (std::filesystem::exists(std::filesystem::path(o.check) / "provenance.json")) {
-        try {
-            shipped = std::make_unique<ShippedReferences>(ReadShippedReferences(o.check));
-        } catch (const Error& e) {
-            std::fprintf(stderr, "atmos: warning: %s: every view renders\n", e.what());
-            unusable = "no usable provenance";
-        }
-    }
-    for (const View& view : views) {
-        Image image, variance;
-        const std::string why = shipped ? LoadMatchingShippedView(*shipped, fingerprint, view.name,
-                                                                  o.noise, o.cap, &image, &variance)
-                                        : unusable;
-        if (why.empty()) {
-            const ShippedView& v = *shipped->Find(view.name);
+    std::vector<std::string> names;
+    for (const View& view : views) names.push_back(view.name);
+    for (const ShippedViewCheck& c :
+         CheckShippedViews(o.check, fingerprint, names, o.noise, o.cap)) {
+        if (c.why.empty()) {
             std::fprintf(stderr, "%s: shipped reference kept (%lld paths per pixel, noise %.4g)\n",
-                         view.name.c_str(), static_cast<long long>(v.paths_per_pixel), v.noise);
+                         c.view.c_str(), static_cast<long long>(c.paths_per_pixel), c.noise);
         } else {
-            std::fprintf(stderr, "%s: to render: %s\n", view.name.c_str(), why.c_str());
-            std::printf("%s\n", view.name.c_str());
+            std::fprintf(stderr, "%s: to render: %s\n", c.view.c_str(), c.why.c_str());
+            std::printf("%s\n", c.view.c_str());
         }
     }
     return 0;
@@ -119,10 +106,7 @@ Command AddReferenceProvenanceCommand(CLI::App* root) {
     cmd->add_option("--entry", o->entry,
                     "--record: the view's entry, a JSON object with view, paths_per_pixel, "
                     "noise and anything else to keep");
-    Command c;
-    c.app = cmd;
-    c.run = [o] { return CmdReferenceProvenance(*o); };
-    return c;
+    return {cmd, [o] { return CmdReferenceProvenance(*o); }};
 }
 
 }  // namespace atmos::cli

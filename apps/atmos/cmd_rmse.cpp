@@ -38,10 +38,7 @@ Command AddRmseCommand(CLI::App* root) {
     cmd->add_option("reference", *ref, "reference image (.exr .npy .pfm .png)")->required();
     cmd->add_option("test", *test, "test image")->required();
     cmd->add_option("--peak", *peak, "signal peak for PSNR")->capture_default_str();
-    Command c;
-    c.app = cmd;
-    c.run = [ref, test, peak] { return CmdRmse(*ref, *test, *peak); };
-    return c;
+    return {cmd, [ref, test, peak] { return CmdRmse(*ref, *test, *peak); }};
 }
 
 }  // namespace atmos::cli

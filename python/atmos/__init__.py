@@ -27,7 +27,7 @@ from ._sun import sun_position
 __all__ = [
     "Atmosphere", "Model", "FlipResult", "RmseResult", "models", "model_info", "views",
     "view_names", "atmosphere_presets", "flip", "rmse", "bake", "read_image", "write_image",
-    "set_threads", "thread_count", "sun_position", "to_srgb",
+    "set_threads", "thread_count", "sun_position", "to_srgb", "validate", "compare", "bench",
 ]
 
 
@@ -437,3 +437,61 @@ def to_srgb(image, exposure=1.0):
     x = 1.0 - _np.exp(-_np.maximum(_np.nan_to_num(x, nan=0.0, posinf=1e30), 0.0))
     srgb = _np.where(x < 0.0031308, 12.92 * x, 1.055 * _np.power(x, 1.0 / 2.4) - 0.055)
     return _np.clip(srgb, 0.0, 1.0).astype(_np.float32)
+
+
+# ---- studies (src/atmos/studies/: the same config, policy and run as the CLI) -----------------
+
+
+def _list(x):
+    if x is None:
+        return []
+    if isinstance(x, str):
+        return [i for i in x.split(",") if i]
+    return [str(i) for i in x]
+
+
+def validate(models=None, *, data=None, atmosphere=None, sets=None, captures=None,
+             theory_azimuth=False, spp=256, seed=0, fit=False, fit_model=None,
+             fit_wavelengths=None, fit_captures=None, fit_evaluations=40,
+             fit_second_lobe=False):
+    """The validate study, as `atmos validate kider-2013`: spectral models against
+    the measured sky of Kider et al. 2014. Returns a dict: wavelengths (40),
+    capture and sample (per direction), measured (directions x 40), models
+    ({spec: {values: directions x 40, errors: [rows as the CSV], seconds}}), sets,
+    fit (None, or the fitted parameters and residuals) and errors_csv (the CSV
+    `atmos validate` writes). Defaults are the CLI's (naive and bruneton, the
+    kider-2013 atmosphere, ../shared/data/kider-2013)."""
+    return _atmos.validate(_list(models), _os.fspath(data) if data else "", atmosphere or "",
+                           _list(sets), _list(captures), bool(theory_azimuth), int(spp),
+                           int(seed), bool(fit), fit_model or "",
+                           [float(v) for v in (fit_wavelengths or [])], _list(fit_captures),
+                           int(fit_evaluations), bool(fit_second_lobe))
+
+
+def compare(output_dir, models=None, *, views=None, size=(320, 180), quantity="radiance",
+            reference=None, reference_spp=None, reference_seed=None, reference_noise=None,
+            atmosphere="earth", sets=None, cache=None, no_cache=False,
+            shipped_references=True, npy=True, progress=False):
+    """The compare study, as `atmos compare -o output_dir`: every model against the
+    reference (default: the path tracer) at the views; writes the same images,
+    tables and index.html. Returns a dict: models, views, reference, flip and rmse
+    (views x models), reference_noise and reference_spp (per view), output_dir."""
+    width, height = size
+    return _atmos.compare(_list(models), _list(views), int(width), int(height), quantity,
+                          reference, reference_spp, reference_seed, reference_noise, atmosphere,
+                          _list(sets), _os.fspath(output_dir),
+                          _os.fspath(cache) if cache is not None else None, bool(no_cache),
+                          bool(shipped_references), bool(npy), bool(progress))
+
+
+def bench(models=None, *, views=None, size=(480, 270), quantity="radiance", repeat=None,
+          warmup=None, prepare_repeat=1, atmosphere="earth", sets=None, spp=None, seed=0,
+          wavelengths=None):
+    """The bench study, as `atmos bench`: Prepare() and renders timed apart, per
+    model and view, on the current backend. Returns a dict: rows (one per model
+    and view: prepare_s, render_median_s, ...), stages, spectral (with
+    wavelengths), threads, backend and csv (the CSV `atmos bench` writes)."""
+    width, height = size
+    return _atmos.bench(_list(models), _list(views), int(width), int(height), quantity, repeat,
+                        warmup, int(prepare_repeat), atmosphere, _list(sets), spp, int(seed),
+                        [float(v) for v in (wavelengths or [])])

@@ -35,6 +35,7 @@
 namespace py = pybind11;
 
 namespace atmos {
+void BindStudies(py::module_& mod);  // python/src/studies.cpp: validate, compare, bench
 namespace {
 
 const char* OptionTypeName(ModelOptionSpec::Type t) {
@@ -574,4 +575,5 @@ PYBIND11_MODULE(_atmos, mod) {
         py::arg("times"), py::arg("latitudes"), py::arg("longitudes"), py::arg("height"),
         py::arg("pressure"), py::arg("temperature"), py::arg("delta_t"), py::arg("refraction"));
     mod.attr("__version__") = ATMOS_VERSION;  // the CMake project's (python/CMakeLists.txt)
+    BindStudies(mod);
 }

@@ -572,48 +572,55 @@ CompareResult RunCompare(const CompareConfig& config) {
     }
     result.loc.push_back(CountModelLoc(source_dir, config.reference_model));
 
+    result.reference_noise_table = split_reference || noise_target || shipped;
+    result.reference_noise_target = noise_target ? mc.noise_target : 0.0;
+    result.total_seconds = SecondsSince(start);
+    return result;
+}
+
+void WriteCompareTables(const CompareConfig& config, const CompareResult& r) {
+    const fs::path out(config.output_dir);
+    fs::create_directories(out);
     // Tables (thesis Appendix A/B, or C/D for transmittance) and times.
     std::vector<std::string> labels;
     std::vector<std::vector<double>> flips, rmses;
     std::vector<double> flip_noise, rmse_noise;
-    for (const CompareRow& row : result.rows) {
+    for (const CompareRow& row : r.rows) {
         labels.push_back(row.label);
         flip_noise.push_back(row.reference_noise);
         rmse_noise.push_back(row.reference_rmse_noise);
-        std::vector<double> f, r;
+        std::vector<double> flip, rmse;
         for (const CompareCell& c : row.cells) {
-            f.push_back(c.flip);
-            r.push_back(c.rmse);
+            flip.push_back(c.flip);
+            rmse.push_back(c.rmse);
         }
-        flips.push_back(f);
-        rmses.push_back(r);
+        flips.push_back(flip);
+        rmses.push_back(rmse);
     }
-    WriteMetricCsv((out / "flip.csv").string(), "FLIP errors", labels, result.models, flips,
-                   flip_noise);
-    WriteMetricCsv((out / "rmse.csv").string(), "RMSE errors", labels, result.models, rmses,
-                   rmse_noise);
-    if (split_reference || noise_target || shipped) {
+    WriteMetricCsv((out / "flip.csv").string(), "FLIP errors", labels, r.models, flips, flip_noise);
+    WriteMetricCsv((out / "rmse.csv").string(), "RMSE errors", labels, r.models, rmses, rmse_noise);
+    if (r.reference_noise_table) {
         // source: rendered, cached or shipped (then provenance: its provenance.json).
         TextOutput f((out / "reference_noise.csv").string());
         f << "view,reference_noise_flip,half_spp,noise_target,source,provenance\n";
-        for (const CompareRow& row : result.rows) {
+        for (const CompareRow& row : r.rows) {
             std::string provenance = row.reference_provenance;
             for (char& c : provenance) c = c == ',' ? ';' : c;
             f << row.view << "," << row.reference_noise << "," << row.reference_spp / 2 << ","
-              << (noise_target ? mc.noise_target : 0.0) << "," << row.reference_source << ","
-              << provenance << "\n";
+              << r.reference_noise_target << "," << row.reference_source << "," << provenance
+              << "\n";
         }
         f.Commit();
     }
-    if (spectral_reference) {
+    if (!config.reference_wavelengths.empty()) {
         // What RGB costs: each model against the spectral and the RGB reference.
         TextOutput f((out / "rgb_cost.csv").string());
         f << "view,model,flip_spectral_reference,flip_rgb_reference,difference\n";
-        for (const CompareRow& row : result.rows) {
-            for (size_t m = 0; m < result.models.size(); ++m) {
+        for (const CompareRow& row : r.rows) {
+            for (size_t m = 0; m < r.models.size(); ++m) {
                 const CompareCell& c = row.cells[m];
-                f << row.view << "," << result.models[m] << "," << c.flip << ","
-                  << c.flip_rgb_reference << "," << c.flip - c.flip_rgb_reference << "\n";
+                f << row.view << "," << r.models[m] << "," << c.flip << "," << c.flip_rgb_reference
+                  << "," << c.flip - c.flip_rgb_reference << "\n";
             }
         }
         f.Commit();
@@ -621,22 +628,19 @@ CompareResult RunCompare(const CompareConfig& config) {
     {
         TextOutput f((out / "times.csv").string());
         f << "view,model,render_seconds,cached,prepare_seconds\n";
-        for (const CompareRow& row : result.rows) {
+        for (const CompareRow& row : r.rows) {
             f << row.view << ",reference:" << config.reference_model << "," << row.reference_seconds
-              << "," << (row.reference_cached ? 1 : 0) << "," << result.reference_prepare_seconds
+              << "," << (row.reference_cached ? 1 : 0) << "," << r.reference_prepare_seconds
               << "\n";
-            for (size_t m = 0; m < result.models.size(); ++m) {
-                f << row.view << "," << result.models[m] << "," << row.cells[m].render_seconds
-                  << "," << (row.cells[m].cached ? 1 : 0) << "," << result.prepare_seconds[m]
-                  << "\n";
+            for (size_t m = 0; m < r.models.size(); ++m) {
+                f << row.view << "," << r.models[m] << "," << row.cells[m].render_seconds << ","
+                  << (row.cells[m].cached ? 1 : 0) << "," << r.prepare_seconds[m] << "\n";
             }
         }
         f.Commit();
     }
-    result.total_seconds = SecondsSince(start);
-    WriteAccuracyCostCsv((out / "accuracy_cost.csv").string(), config, result);
-    WriteCompareReport((out / "index.html").string(), config, result);
-    return result;
+    WriteAccuracyCostCsv((out / "accuracy_cost.csv").string(), config, r);
+    WriteCompareReport((out / "index.html").string(), config, r);
 }
 
 }  // namespace atmos

@@ -1,4 +1,5 @@
-// atmos: the comparison harness behind `atmos compare` (DESIGN.md; seed 003
+// atmos: the comparison harness behind `atmos compare` (DESIGN.md; Leenman 2025,
+// "A visual and performance comparison of atmospheric scattering models",
 // sections 11.5-11.7 and Appendix A-D).
 //
 // For each view and model: render (or load from the render cache) the
@@ -32,7 +33,7 @@ struct CompareConfig {
     int width = 320;
     int height = 180;
     Quantity quantity = Quantity::kRadiance;
-    std::string reference_model = "naive";
+    std::string reference_model = "reference";  // the path tracer: the one default reference
     std::map<std::string, std::string> reference_options;
     // A Monte Carlo reference's estimate (spp, seed; split into halves, see
     // CompareRow). With reference_monte_carlo.noise_target > 0 each view's
@@ -138,6 +139,11 @@ struct CompareResult {
     std::vector<ModelLoc> loc;  // per registered model (once), plus the reference model last
     double total_seconds = 0.0;
     int threads = 0;
+    // The reference's noise was measured (a split or noise-target Monte Carlo
+    // reference, or shipped references): reference_noise.csv is written, with
+    // the noise target (0: none).
+    bool reference_noise_table = false;
+    double reference_noise_target = 0.0;
 };
 
 // The default views: all 12 for radiance; for transmittance the thesis's five
@@ -153,9 +159,15 @@ std::string ValidityNote(const ModelCapabilities& caps, const View& view,
 // (e.g. `hillaire:segment-offset=0.5`), so that variants of one model are
 // compared side by side; the spec text names the model's column and files.
 
-// Runs the comparison and writes images, error maps, flip.csv, rmse.csv,
-// times.csv and index.html into config.output_dir. Throws atmos::Error.
+// Runs the comparison (studies/compare.h resolves the config) and writes each
+// view's images and error maps into config.output_dir as it goes (they are too
+// large to keep); the tables and the report are WriteCompareTables'. Throws
+// atmos::Error.
 CompareResult RunCompare(const CompareConfig& config);
+// The writers of a result: flip.csv, rmse.csv, times.csv, reference_noise.csv
+// (when measured), rgb_cost.csv (reference_wavelengths), accuracy_cost.csv and
+// index.html in config.output_dir. They only read `result`.
+void WriteCompareTables(const CompareConfig& config, const CompareResult& result);
 
 // A metric table as CSV (thesis Appendix A/B layout): the header
 // "<corner>,<model>...,best", then one row per view with the values (%.8g)

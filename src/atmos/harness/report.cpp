@@ -529,25 +529,24 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
     auto item = [&](const std::string& k, const std::string& v) {
         f << "<dt>" << HtmlEscape(k) << "</dt><dd>" << HtmlEscape(v) << "</dd>\n";
     };
-    std::string ref_opts;
-    for (const auto& [k, v] : config.reference_options) {
-        ref_opts += (ref_opts.empty() ? "" : " ") + std::string("--") + k + " " + v;
-    }
+    std::string ref_opts;  // as a model spec: NAME:OPTION=VALUE:...
+    for (const auto& [k, v] : config.reference_options) ref_opts += ":" + k + "=" + v;
     item("reference",
-         config.reference_model + (ref_opts.empty() ? "" : " " + ref_opts) +
+         config.reference_model + ref_opts +
              (config.reference_note.empty() ? "" : " (" + config.reference_note + ")"));
     item("quantity", QuantityName(config.quantity));
     item("size", std::to_string(config.width) + "x" + std::to_string(config.height));
     item("atmosphere", config.atmosphere_name);
     const double ppd = config.flip.ppd > 0.0 ? config.flip.ppd : FlipDefaultPpd();
-    item("metric", transmittance ? "LDR-FLIP (transmittance as linear RGB in [0, 1]), RMSE"
-                                 : std::string("HDR-FLIP (tone mapper ") +
-                                       FlipToneMapperName(config.flip.tone_mapper) +
-                                       ", exposure range from the reference, black pixels: " +
-                                       (config.flip.exposure_setup == FlipExposureSetup::kThesis
-                                            ? "thesis (1e-9 added to every pixel, seed 003 11.5)"
-                                            : "atmos (median over non-black pixels)") +
-                                       "), RMSE over all channels");
+    item("metric", transmittance
+                       ? "LDR-FLIP (transmittance as linear RGB in [0, 1]), RMSE"
+                       : std::string("HDR-FLIP (tone mapper ") +
+                             FlipToneMapperName(config.flip.tone_mapper) +
+                             ", exposure range from the reference, black pixels: " +
+                             (config.flip.exposure_setup == FlipExposureSetup::kThesis
+                                  ? "thesis (1e-9 added to every pixel, Leenman 2025 section 11.5)"
+                                  : "atmos (median over non-black pixels)") +
+                             "), RMSE over all channels");
     item("pixels per degree", Fixed(ppd, 4));
     item("models", std::to_string(r.models.size()));
     // Each model's options as compared (the defaults unless the spec sets
@@ -613,7 +612,7 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
     f << "<p>Per view and model in <a href=\"times.csv\">times.csv</a>; "
          "<code>atmos bench</code> measures medians of repeated runs.</p>\n";
 
-    f << "<h2>Significant lines of code</h2>\n<p>Counted by the rules of the thesis (seed 003 "
+    f << "<h2>Significant lines of code</h2>\n<p>Counted by the rules of the thesis (Leenman 2025 "
          "section 11.7) over each model's own files; the thesis's counts from its section 12.4."
          "</p>\n<table><tr><th>model</th><th>lines (atmos)</th><th>lines (thesis)</th>"
          "<th>files</th></tr>\n";

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -328,6 +329,38 @@ void RecordShippedView(const std::string& directory, const ReferenceFingerprint&
     if (!replaced) views.push_back(entry);
     fs::create_directories(directory);
     WriteFileAtomically(path.string(), ProvenanceText(FingerprintFields(run), views));
+}
+
+std::vector<ShippedViewCheck> CheckShippedViews(const std::string& directory,
+                                                const ReferenceFingerprint& run,
+                                                const std::vector<std::string>& views,
+                                                double noise_target, int64_t spp) {
+    std::unique_ptr<ShippedReferences> shipped;
+    std::string unusable = "no provenance";
+    if (std::filesystem::exists(std::filesystem::path(directory) / "provenance.json")) {
+        try {
+            shipped = std::make_unique<ShippedReferences>(ReadShippedReferences(directory));
+        } catch (const Error& e) {
+            std::fprintf(stderr, "atmos: warning: %s: every view renders\n", e.what());
+            unusable = "no usable provenance";
+        }
+    }
+    std::vector<ShippedViewCheck> checks;
+    for (const std::string& view : views) {
+        ShippedViewCheck c;
+        c.view = view;
+        Image image, variance;
+        c.why = shipped ? LoadMatchingShippedView(*shipped, run, view, noise_target, spp, &image,
+                                                  &variance)
+                        : unusable;
+        if (c.why.empty()) {
+            const ShippedView& v = *shipped->Find(view);
+            c.paths_per_pixel = v.paths_per_pixel;
+            c.noise = v.noise;
+        }
+        checks.push_back(c);
+    }
+    return checks;
 }
 
 }  // namespace atmos

@@ -112,6 +112,21 @@ std::string LoadMatchingShippedView(const ShippedReferences& shipped,
                                     double noise_target, int64_t spp, Image* image,
                                     Image* variance);
 
+// Which views' shipped images in `directory` stand for the run (`atmos
+// reference-provenance --check`): per view, "" when its image is kept, else why
+// it must render ("no provenance" when the directory has none; a damaged
+// provenance.json is a warning on stderr and every view renders).
+struct ShippedViewCheck {
+    std::string view;
+    std::string why;              // "" : kept
+    int64_t paths_per_pixel = 0;  // of a kept image
+    double noise = 0.0;
+};
+std::vector<ShippedViewCheck> CheckShippedViews(const std::string& directory,
+                                                const ReferenceFingerprint& run,
+                                                const std::vector<std::string>& views,
+                                                double noise_target, int64_t spp);
+
 // Adds (or replaces) one view's entry in DIR/provenance.json, written
 // atomically: `entry_json` is a JSON object with at least view (one of
 // `run`'s views), paths_per_pixel and noise; its view_hash is set from `run`.

@@ -1,10 +1,10 @@
 // atmos: spectral rendering and sampling (docs/architecture.md "Spectral rendering").
 //
 // The models compute three channels. A spectral run evaluates a SpectralAtmosphere
-// at the wavelengths in batches of three (SpectralBatches: neighbours by default;
-// a short batch repeats its last wavelength), prepares a fresh model per batch and renders or
-// samples it: the models are unchanged, as in Bruneton 2017's precomputation of N wavelengths in
-// batches. Monte Carlo models take a seed per batch (SpectralBatching; no
+// at the wavelengths in batches of three (SpectralBatches: interleaved by default,
+// neighbours on request; a short batch repeats its last wavelength), prepares a fresh model per
+// batch and renders or samples it: the models are unchanged, as in Bruneton 2017's precomputation
+// of N wavelengths in batches. Monte Carlo models take a seed per batch (SpectralBatching; no
 // checkpoints or variance).
 #pragma once
 

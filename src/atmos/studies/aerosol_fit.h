@@ -1,6 +1,7 @@
-// atmos CLI: `atmos validate kider-2013 --fit`: the aerosol of an atmosphere
-// (Angstrom beta and alpha, single-scattering albedo, Cornette-Shanks g) fitted
-// to the measured sky by bounded least squares (docs/harness.md "Aerosol fit").
+// atmos studies: the aerosol fit of the validate study (`atmos validate kider-2013
+// --fit`, studies/validate.h): the aerosol of an atmosphere (Angstrom beta and
+// alpha, single-scattering albedo, Cornette-Shanks g) fitted to the measured sky
+// by bounded least squares (docs/harness.md "Aerosol fit").
 #pragma once
 
 #include <string>
@@ -10,7 +11,7 @@
 #include "atmos/spectral.h"
 #include "harness/kider.h"
 
-namespace atmos::cli {
+namespace atmos {
 
 // The parameters, their bounds and the --set field each one writes: the four
 // of every fit, then the second Mie lobe's two (--fit-second-lobe).
@@ -76,4 +77,4 @@ AerosolFit FitAerosol(const AerosolFitSettings& settings, const std::string& atm
 // The Kider bin index of a wavelength (-1 when it is not one of the 40 bins).
 int KiderBinIndex(double nm);
 
-}  // namespace atmos::cli
+}  // namespace atmos

@@ -1,5 +1,5 @@
-// atmos CLI: the aerosol fit of `atmos validate kider-2013 --fit` (validate_fit.h).
-#include "validate_fit.h"
+// atmos studies: the aerosol fit of the validate study (aerosol_fit.h).
+#include "studies/aerosol_fit.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +16,7 @@
 #include "atmos/spectral.h"
 #include "harness/spectral_run.h"
 
-namespace atmos::cli {
+namespace atmos {
 
 namespace {
 
@@ -210,4 +210,4 @@ AerosolFit FitAerosol(const AerosolFitSettings& settings, const std::string& atm
 #endif
 }
 
-}  // namespace atmos::cli
+}  // namespace atmos

@@ -1,0 +1,70 @@
+// atmos studies: the compare study (`atmos compare`, Python atmos.compare):
+// every model against the reference at the views (harness/compare.h runs it and
+// writes its images; the tables and the report are its writers).
+//
+// A CompareRequest is what a user asks for; ResolveCompareConfig applies the
+// defaults and the policy (the reference and its Monte Carlo estimate, the
+// shipped references, the cache directory, the spectral checks) and gives the
+// CompareConfig that RunCompare runs. Every default is here or in CompareConfig.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "harness/compare.h"
+
+namespace atmos {
+
+// A Monte Carlo reference's estimate when no flag sets it: a noise target (the
+// HDR-FLIP between its two halves) capped at kCompareReferenceCap paths per
+// pixel; a fixed count alone is kCompareReferenceSpp unless given.
+constexpr int64_t kCompareReferenceSpp = 64;
+constexpr double kCompareReferenceNoise = 0.01;
+constexpr int64_t kCompareReferenceCap = 512;
+
+struct CompareRequest {
+    std::vector<std::string>
+        models;  // specs; empty: every model with the quantity but the reference
+    std::vector<std::string> views;  // empty: DefaultCompareViews(quantity)
+    int width = 320, height = 180;
+    std::string quantity = "radiance";  // radiance (HDR-FLIP) or transmittance (LDR-FLIP)
+    // The reference NAME[:OPTION=VALUE...]; unset: CompareConfig's (the path tracer).
+    std::optional<std::string> reference;
+    // A Monte Carlo reference's estimate: the noise target alone (default
+    // kCompareReferenceNoise, capped at spp or kCompareReferenceCap), or a
+    // fixed spp alone (noise off; default kCompareReferenceSpp); 0 noise: fixed.
+    std::optional<int64_t> reference_spp, reference_seed;
+    std::optional<double> reference_noise;
+    std::string atmosphere = "earth";  // preset name or JSON file
+    std::vector<std::string> sets;     // FIELD=VALUE overrides
+    std::string output_dir;            // empty: out (radiance) or out/transmittance
+    // The render cache: unset: out/cache, or OUTPUT/cache when output_dir is
+    // given; no_cache: none. CUDA images get their own sub-directory.
+    std::optional<std::string> cache_dir;
+    bool no_cache = false;
+    bool cuda = false;  // the images come from the CUDA backend
+    bool write_npy = true;
+    bool show_progress = true;
+    double ppd = 0.0;                  // FLIP pixels per degree (0: the default 67.0206)
+    std::string tone_mapper = "aces";  // HDR-FLIP: aces, hable, reinhard
+    std::string exposure = "atmos";    // HDR-FLIP black pixels: atmos or thesis
+    // Spectral: every model and the reference at these wavelengths (linear sRGB with `white`).
+    std::vector<double> wavelengths;
+    std::string colour = "srgb";  // only srgb compares
+    std::string white = "d65";
+    SpectralBatching batching;
+    // What RGB costs: the reference alone at these wavelengths, the models in RGB.
+    std::vector<double> reference_wavelengths;
+    // Shipped references: unset: data/references/WxH of the source tree when it
+    // exists and the reference renders to a noise target; no_shipped: never.
+    std::optional<std::string> shipped_references;
+    bool no_shipped = false;
+    std::string command_line;  // for the report
+};
+
+// The defaults and the policy; throws atmos::Error naming the flag.
+CompareConfig ResolveCompareConfig(const CompareRequest& request);
+
+}  // namespace atmos

@@ -1,0 +1,59 @@
+// atmos studies: the writers of a spectral sample run (spectral_sample.h).
+#include "studies/spectral_sample.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "atmos/spectral.h"
+
+namespace atmos {
+
+std::string SpectralSampleCsv(const std::vector<double>& nm,
+                              const std::vector<SampleQuery>& queries,
+                              const std::vector<double>& values) {
+    const std::vector<double> weights = WavelengthWeights(nm);
+    const size_t n = nm.size();
+    std::string text;
+    char cell[64];
+    // A number as printf's %.17g (the query's inputs) or %.9g (float outputs).
+    const auto put = [&](bool comma, bool full_precision, double v) {
+        if (comma) text += ',';
+        const int len = full_precision ? std::snprintf(cell, sizeof cell, "%.17g", v)
+                                       : std::snprintf(cell, sizeof cell, "%.9g", v);
+        text.append(cell, static_cast<size_t>(std::max(len, 0)));
+    };
+    text += "altitude_m,mu,mu_s,azimuth_deg";
+    for (double l : nm) text += ",L_" + WavelengthLabel(l);
+    text += ",X,Y,Z\n";
+    for (size_t q = 0; q < queries.size(); ++q) {
+        put(false, true, queries[q].altitude_m);
+        put(true, true, queries[q].mu);
+        put(true, true, queries[q].mu_s);
+        put(true, true, queries[q].azimuth_deg);
+        for (size_t i = 0; i < n; ++i) put(true, false, values[q * n + i]);
+        const Vec3d xyz = SpectrumToXyz(nm, weights, values.data() + q * n);
+        put(true, false, kMaxLuminousEfficacy * xyz.x);
+        put(true, false, kMaxLuminousEfficacy * xyz.y);
+        put(true, false, kMaxLuminousEfficacy * xyz.z);
+        text += "\n";
+    }
+    return text;
+}
+
+std::vector<float> SpectralSampleArray(const std::vector<double>& nm, size_t queries,
+                                       const std::vector<double>& values) {
+    const std::vector<double> weights = WavelengthWeights(nm);
+    const size_t n = nm.size();
+    std::vector<float> array(queries * (n + 3));
+    for (size_t q = 0; q < queries; ++q) {
+        float* row = array.data() + q * (n + 3);
+        for (size_t i = 0; i < n; ++i) row[i] = static_cast<float>(values[q * n + i]);
+        const Vec3d xyz = SpectrumToXyz(nm, weights, values.data() + q * n);
+        for (int k = 0; k < 3; ++k) {
+            row[n + static_cast<size_t>(k)] = static_cast<float>(kMaxLuminousEfficacy * xyz[k]);
+        }
+    }
+    return array;
+}
+
+}  // namespace atmos
