@@ -14,12 +14,12 @@
 
 #include "atmos/error.h"
 #include "atmos/model.h"
-#include "bake_rgba.h"
-#include "bake_shaders.h"
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "embedded_assets.h"
+#include "io/engine_shaders.h"
 #include "io/output_path.h"
+#include "io/rgba_tables.h"
 #include "io/text_files.h"
 
 namespace atmos::cli {

@@ -1,10 +1,10 @@
-// atmos CLI: the engine shader stages of a bake (issue 35 item 1; docs/engine.md,
+// atmos io: the engine shader stages of a bake (issue 35 item 1; docs/engine.md,
 // "Vulkan, HLSL and Metal").
 #pragma once
 
 #include <string>
 
-namespace atmos::cli {
+namespace atmos {
 
 // From the WebGL2 GLSL a bake has just written to DIR/shaders/ (NAME_constants.glsl,
 // common.glsl, NAME.glsl), writes complete Vulkan GLSL stages
@@ -22,4 +22,4 @@ void WriteEngineShaders(const std::string& dir, const std::string& model_name, b
 // Both glslangValidator and spirv-cross are on the PATH.
 bool EngineShaderToolsFound();
 
-}  // namespace atmos::cli
+}  // namespace atmos

@@ -1,4 +1,4 @@
-// atmos CLI: `bake --layout rgba`: the tables as 4-channel float16 and float32
+// atmos io: `bake --layout rgba`: the tables as 4-channel float16 and float32
 // textures, in raw blobs and KTX2 files (issue 35 item 2; docs/engine.md,
 // "RGBA tables and KTX2").
 #pragma once
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace atmos::cli {
+namespace atmos {
 
 // From a bake in `dir` (NAME.json's "raw", tables.f32, tables.f16), writes
 // DIR/tables_rgba.f32 and DIR/tables_rgba.f16 (each table padded to 4 channels,
@@ -26,4 +26,4 @@ void WriteRgbaTables(const std::string& dir, const std::string& model_name);
 std::string Ktx2File(int width, int height, int depth, int bytes_per_channel,
                      const std::string& texels);
 
-}  // namespace atmos::cli
+}  // namespace atmos

@@ -1,7 +1,7 @@
-// atmos CLI: the engine shader stages of a bake (bake_shaders.h): Vulkan GLSL
+// atmos io: the engine shader stages of a bake (bake_shaders.h): Vulkan GLSL
 // from the one WebGL2 GLSL source, translated by glslang (SPIR-V) and
 // SPIRV-Cross (HLSL, Metal).
-#include "bake_shaders.h"
+#include "io/engine_shaders.h"
 
 #include <sys/wait.h>
 #include <cstdio>
@@ -15,7 +15,7 @@
 #include "atmos/error.h"
 #include "io/output_path.h"
 
-namespace atmos::cli {
+namespace atmos {
 
 namespace engine_shaders {
 
@@ -325,4 +325,4 @@ void WriteEngineShaders(const std::string& dir_text, const std::string& model_na
     }
 }
 
-}  // namespace atmos::cli
+}  // namespace atmos

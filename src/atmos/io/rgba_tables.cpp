@@ -1,6 +1,6 @@
-// atmos CLI: `bake --layout rgba` (bake_rgba.h): RGBA16F/RGBA32F raw blobs and
+// atmos io: `bake --layout rgba` (bake_rgba.h): RGBA16F/RGBA32F raw blobs and
 // KTX2 files. A small KTX2 writer of our own: Debian bookworm has no libktx.
-#include "bake_rgba.h"
+#include "io/rgba_tables.h"
 
 #include <algorithm>
 #include <cstring>
@@ -12,7 +12,7 @@
 #include "atmos/error.h"
 #include "io/output_path.h"
 
-namespace atmos::cli {
+namespace atmos {
 
 namespace rgba_tables {
 
@@ -198,4 +198,4 @@ void WriteRgbaTables(const std::string& dir_text, const std::string& model_name)
     WriteFileAtomically((dir / "tables_rgba.json").string(), doc.dump(2) + "\n");
 }
 
-}  // namespace atmos::cli
+}  // namespace atmos
