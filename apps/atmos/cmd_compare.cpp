@@ -93,7 +93,7 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
                         "noise target of a Monte Carlo reference: each view renders until the "
                         "HDR-FLIP between its two halves (even and odd passes) is at or below it, "
                         "at most --reference-spp paths per pixel (default then " +
-                            std::to_string(kDefaultReferenceCap) +
+                            std::to_string(kCompareReferenceCap) +
                             "); 0, or "
                             "--reference-spp given alone: a fixed --reference-spp (two halves of "
                             "spp/2, seeds 2s+1 and 2s+2)")
@@ -103,7 +103,7 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
                                   "count (two halves of spp/2; default below); with "
                                   "--reference-noise, the cap. Effective cap when neither is "
                                   "given (the default noise target): " +
-                                      std::to_string(kDefaultReferenceCap))
+                                      std::to_string(kCompareReferenceCap))
                       ->capture_default_str();
     o->seed_flag = cmd->add_option("--reference-seed", o->reference_seed,
                                    "random seed s of a Monte Carlo reference, in [0, 4294967295]")
