@@ -28,13 +28,20 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// shaders/NAME.glsl for a model name ("atmosphere-plus" -> atmosphere_plus).
+// shaders/FILE.glsl of a model that declares one (ModelCapabilities::shader),
+// or "" for one that does not.
 std::string ShaderAsset(const std::string& model) {
-    std::string file = model;
-    for (char& c : file) {
-        if (c == '-') c = '_';
+    const std::string& file = GetModelInfo(model).capabilities.shader;
+    return file.empty() ? "" : "shaders/" + file + ".glsl";
+}
+
+// The viewer's default list: every model with a shader, in registry order.
+std::vector<std::string> ShaderModels() {
+    std::vector<std::string> names;
+    for (const ModelInfo& info : ListModels()) {
+        if (!info.capabilities.shader.empty()) names.push_back(info.name);
     }
-    return "shaders/" + file + ".glsl";
+    return names;
 }
 
 // The math and geometry every model's shader uses (GLSL has no #include: a
@@ -182,8 +189,9 @@ Command AddViewerCommand(CLI::App* root) {
     c.app
         ->add_option("--models", *models,
                      "models to bake, NAME[:OPTION=VALUE...] comma-separated (default: "
-                     "bruneton,hillaire,atmosphere-plus); with --load DIR, one model read "
-                     "from DIR (default: the model of DIR's bake)")
+                     "every model with a viewer shader: hillaire,bruneton,atmosphere-plus); "
+                     "with --load DIR, one model read from DIR (default: the model of DIR's "
+                     "bake)")
         ->delimiter(',');
     CLI::Option* model_flag = c.app->get_option("--model");
     c.run = [common, output, models, model_flag] {
@@ -193,15 +201,18 @@ Command AddViewerCommand(CLI::App* root) {
             specs.push_back(common->model);  // --model: one model, as for bake
         }
         if (specs.empty() && !common->load.empty()) specs = {BakedModelSpec(common->load)};
-        if (specs.empty()) specs = {"bruneton", "hillaire", "atmosphere-plus"};
+        if (specs.empty()) specs = ShaderModels();
         if (!common->load.empty() && specs.size() != 1) {
             Fail("--load reads one model's tables: give one model in --models");
         }
         for (const std::string& spec : specs) {  // before any precomputation
             const std::string name = ParseModelSpec(spec).name;
-            if (!FindAsset(ShaderAsset(name))) {
-                Fail("model ", name, " has no shaders (", ShaderAsset(name),
-                     "): the viewer shows bruneton, hillaire and atmosphere-plus");
+            if (ShaderAsset(name).empty() || !FindAsset(ShaderAsset(name))) {
+                std::string list;
+                for (const std::string& m : ShaderModels()) list += (list.empty() ? "" : ", ") + m;
+                Fail("model ", name, " has no shaders (",
+                     ShaderAsset(name).empty() ? "none declared" : ShaderAsset(name),
+                     "): the viewer shows ", list);
             }
         }
         const fs::path dir(*output);

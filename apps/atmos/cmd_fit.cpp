@@ -32,7 +32,10 @@ struct FitOptions {
 };
 
 int CmdFit(const FitOptions& o) {
-    if (o.model != "neural") Fail("fit: only --model neural can be fitted, got '", o.model, "'");
+    bool trainable = false;  // a registered model that declares it (ModelCapabilities)
+    for (const ModelInfo& info : ListModels())
+        trainable |= info.name == o.model && info.capabilities.trainable;
+    if (!trainable) Fail("fit: only --model neural can be fitted, got '", o.model, "'");
     if (o.reference == o.model) Fail("fit: --reference cannot be the model being fitted");
     if (o.output.empty()) Fail("fit: -o FILE.json is required");
     CheckOutputFile(o.output);     // before the fit (io/output_path.h)

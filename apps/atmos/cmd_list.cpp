@@ -20,6 +20,7 @@
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "harness/gallery.h"
+#include "harness/listing.h"
 
 namespace fs = std::filesystem;
 
@@ -28,31 +29,7 @@ namespace atmos::cli {
 namespace {
 
 void PrintCapabilities(const ModelInfo& info) {
-    const ModelCapabilities& c = info.capabilities;
-    std::printf(
-        "  %-16s   quantities: %s%s%s; space views: %s; sun below horizon: %s; "
-        "multiple scattering: %s%s%s\n",
-        "", c.radiance ? "radiance" : "", c.radiance && c.transmittance ? ", " : "",
-        c.transmittance ? "transmittance" : "", c.space_views ? "yes" : "no",
-        c.sun_below_horizon ? "yes" : "no", c.multiple_scattering ? "yes" : "no",
-        c.precomputed ? "; precomputed" : "", c.stochastic ? "; Monte Carlo" : "");
-    // Issue 18 item 4: the models whose precomputation checks that its
-    // scattering orders decrease (models/order_check.h).
-    if (info.name == "bruneton" || info.name == "atmosphere-plus") {
-        std::printf(
-            "  %-16s   validity: optically thick steps of the view-ray integrals use an "
-            "energy-conserving rule (physics/exp_quadrature.h); Prepare still warns on stderr "
-            "when a precomputed scattering order stops decreasing, and the radiance is then not "
-            "valid\n",
-            "");
-    }
-    if (info.name == "hillaire") {
-        std::printf(
-            "  %-16s   validity: optically thick atmospheres are past the method's limit: "
-            "Prepare warns on stderr when the multiple-scattering transfer f_ms exceeds 0.5 "
-            "(the series 1 / (1 - f_ms) then over-brightens: +42 %% to +110 %% measured)\n",
-            "");
-    }
+    std::printf("%s", ModelCapabilitiesText(info).c_str());  // harness/listing.h
 }
 
 // `atmos list NAME`: one model with its option table (its own defaults).

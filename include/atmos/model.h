@@ -38,6 +38,45 @@ struct ModelCapabilities {
     // model renders passes and the progressive driver (src/atmos/render/
     // progressive.h) runs them, with checkpoints, resume and the variance.
     bool stochastic = false;
+    // Has a per-wavelength form (harness/spectral_run.h): its inputs are an
+    // atmosphere's coefficients (the physical models) or it builds a spectral
+    // form of its own (preetham). false: compare/bench skip it in spectral
+    // runs and --wavelengths refuses it.
+    bool spectral = true;
+    // `atmos fit` trains its weights against a reference model.
+    bool trainable = false;
+    // The WebGL2 shader (shaders/NAME.glsl, without the directory) that draws
+    // its baked tables in `atmos viewer`; empty: none. The models with one are
+    // the viewer's default list, in registry order.
+    std::string shader;
+    // Lines `atmos list` prints under "validity:" (what the tables or the
+    // method do outside their range, measured).
+    std::vector<std::string> validity_notes;
+};
+
+// Where a model's answers are valid for an atmosphere (issues 38 item 3, 39
+// item 5), as measured against the reference (docs/models/NAME.md). Each limit
+// 0 is none (the default: a model that declares nothing is checked for
+// nothing). Prepare() warns on stderr outside it with the model's name and the
+// reason (WarnOutsideValidityDomain); `atmos list` prints it.
+struct ValidityDomain {
+    // Largest top_radius / bottom_radius (the shell's thickness).
+    double max_radius_ratio = 0.0;
+    std::string radius_ratio_reason;
+    // Largest shell thickness (top - bottom) in equivalent heights of the
+    // column (ColumnEquivalentHeight): how much empty shell a model's fixed
+    // step counts spread over (a giant planet's 10^9 m shell over a few-km air
+    // column).
+    double max_shell_heights = 0.0;
+    std::string shell_heights_reason;
+    // Largest planet radius (bottom) in column heights: the curvature a
+    // method's fitted constants assume (O'Neil's scale()).
+    double max_radius_heights = 0.0;
+    std::string radius_heights_reason;
+    // Largest vertical optical depth of the column (extinction of all
+    // constituents, largest channel: VerticalOpticalDepth).
+    double max_optical_depth = 0.0;
+    std::string optical_depth_reason;
 };
 
 struct ModelInfo {
@@ -46,7 +85,15 @@ struct ModelInfo {
     std::string citation;  // paper + seed section
     std::string summary;   // one line
     ModelCapabilities capabilities;
+    ValidityDomain domain;
     std::vector<ModelOptionSpec> options;  // from the model's OptionTable (atmos/options.h)
+    // `atmos loc` (harness/loc.h): the stem of its source files under
+    // src/atmos/models/ (STEM.h, STEM.cpp, STEM_*.h ...; empty: the name with
+    // '-' as '_'), and the thesis's count of the same model (seed 003 section
+    // 12.4: its name there and its significant lines; -1: not in the thesis).
+    std::string source_stem;
+    std::string thesis_name;
+    int thesis_lines = -1;
 };
 
 // A model with options, as written everywhere (command line, compare, bench):
@@ -192,6 +239,22 @@ class Model {
 int64_t OutputGuardCount();
 void ResetOutputGuardCount(int64_t value = 0);  // tests: restore a count
 
+// The vertical optical depth of the atmosphere's column from the ground to the
+// top (all constituents, the largest channel), by the trapezoid rule on a
+// geometric altitude grid (valid for a giant planet's 10^9 m shell too).
+double VerticalOpticalDepth(const AtmosphereParameters& atmosphere);
+// The column's equivalent height: its vertical optical depth over the
+// extinction at the ground (largest channels; Earth: 7.2 km); the shell's
+// thickness when the ground has no extinction.
+double ColumnEquivalentHeight(const AtmosphereParameters& atmosphere);
+// The reasons `atmosphere` is outside `info`'s ValidityDomain, one line each
+// ("optical depth 31 above 10: ..."); empty inside it.
+std::vector<std::string> ValidityDomainViolations(const ModelInfo& info,
+                                                  const AtmosphereParameters& atmosphere);
+// Prints "atmos: warning: model NAME: outside its valid domain: REASON" on
+// stderr for each violation (models call it at the start of Prepare()).
+void WarnOutsideValidityDomain(const ModelInfo& info, const AtmosphereParameters& atmosphere);
+
 // All registered models, in the registry's order (src/atmos/models/registry.cpp).
 std::vector<ModelInfo> ListModels();
 const ModelInfo& GetModelInfo(const std::string& name);  // throws for an unknown name
@@ -204,5 +267,20 @@ std::unique_ptr<Model> CreateModel(const ModelSpec& spec);
 // its table's order (defaults included). Throws like CreateModel.
 std::vector<std::pair<std::string, std::string>> ResolveModelOptions(
     const std::string& name, const std::map<std::string, std::string>& given);
+
+// Run-time registration, for models that are not in THE list
+// (models/model_list.h): a test registers a model defined in its own file
+// (tests/capabilities_test.cpp). Appends it after the listed models; the
+// registration lasts until Unregister (not thread-safe against concurrent
+// lookups: register before, unregister after any use).
+struct ModelFactory {
+    std::function<ModelInfo()> info;
+    std::function<std::unique_ptr<Model>(const std::map<std::string, std::string>&)> create;
+    std::function<std::vector<std::pair<std::string, std::string>>(
+        const std::map<std::string, std::string>&)>
+        resolve;
+};
+void RegisterModel(const ModelFactory& factory);  // throws for a name already registered
+void UnregisterModel(const std::string& name);    // run-time registrations only
 
 }  // namespace atmos

@@ -67,7 +67,21 @@ py::dict InfoDict(const ModelInfo& info) {
     caps["multiple_scattering"] = c.multiple_scattering;
     caps["precomputed"] = c.precomputed;
     caps["stochastic"] = c.stochastic;
+    caps["spectral"] = c.spectral;
+    caps["trainable"] = c.trainable;
+    caps["shader"] = c.shader;
+    caps["validity_notes"] = c.validity_notes;
     d["capabilities"] = caps;
+    py::dict domain;  // 0: no limit
+    domain["max_radius_ratio"] = info.domain.max_radius_ratio;
+    domain["radius_ratio_reason"] = info.domain.radius_ratio_reason;
+    domain["max_shell_heights"] = info.domain.max_shell_heights;
+    domain["shell_heights_reason"] = info.domain.shell_heights_reason;
+    domain["max_radius_heights"] = info.domain.max_radius_heights;
+    domain["radius_heights_reason"] = info.domain.radius_heights_reason;
+    domain["max_optical_depth"] = info.domain.max_optical_depth;
+    domain["optical_depth_reason"] = info.domain.optical_depth_reason;
+    d["domain"] = domain;
     py::list options;
     for (const ModelOptionSpec& s : info.options) {
         py::dict o;

@@ -297,7 +297,7 @@ CompareResult RunCompare(const CompareConfig& config) {
     std::vector<ModelSpec> specs;
     if (config.models.empty()) {
         for (const ModelInfo& info : ListModels()) {
-            if (info.name == "reference") continue;
+            if (info.capabilities.stochastic) continue;  // Monte Carlo: a reference
             if (!config.wavelengths.empty() && !HasSpectralForm(info)) continue;
             if (transmittance ? !info.capabilities.transmittance : !info.capabilities.radiance) {
                 continue;

@@ -28,7 +28,7 @@ namespace atmos {
 
 struct CompareConfig {
     std::vector<std::string>
-        models;  // empty: every registered model with the quantity, but `reference`
+        models;  // empty: every registered model with the quantity, but Monte Carlo ones
     std::vector<std::string> views;  // empty: DefaultCompareViews(quantity)
     int width = 320;
     int height = 180;

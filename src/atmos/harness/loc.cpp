@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "atmos/error.h"
+#include "atmos/model.h"
 
 namespace fs = std::filesystem;
 
@@ -93,8 +94,20 @@ int CountSignificantLinesInFile(const std::string& path) {
     return CountSignificantLines(ss.str());
 }
 
+namespace {
+// The registered model a name or spec ("bruneton:orders=2") stands for, or null.
+const ModelInfo* RegisteredInfo(const std::string& model) {
+    const std::string name = model.substr(0, model.find(':'));
+    for (const ModelInfo& info : ListModels()) {
+        if (info.name == name) return &GetModelInfo(name);
+    }
+    return nullptr;
+}
+}  // namespace
+
 std::vector<std::string> ModelSourceFiles(const std::string& source_dir, const std::string& name) {
-    std::string stem = name;
+    const ModelInfo* info = RegisteredInfo(name);
+    std::string stem = info != nullptr && !info->source_stem.empty() ? info->source_stem : name;
     std::replace(stem.begin(), stem.end(), '-', '_');
     std::vector<std::string> files;
     const fs::path dir = fs::path(source_dir) / "src" / "atmos" / "models";
@@ -115,31 +128,11 @@ std::vector<std::string> ModelSourceFiles(const std::string& source_dir, const s
 }
 
 int ThesisLoc(const std::string& model, std::string* thesis_name) {
-    // Seed 003 section 12.4, "significant lines of code".
-    struct Row {
-        const char* prefix;
-        const char* name;
-        int lines;
-    };
-    static const Row kRows[] = {
-        {"preetham", "Preetham, Shirley and Smits", 58},
-        {"flat", "Flat", 58},
-        {"raymarched", "Raymarched", 74},
-        {"neural", "Neural network", 94},
-        {"schuler", "Schuler", 106},
-        {"naive", "Naive", 118},
-        {"reference", "Path tracer", 147},
-        {"path", "Path tracer", 147},
-        {"hillaire", "Hillaire", 208},
-        {"bruneton", "Bruneton and Neyret", 832},
-    };
-    for (const Row& r : kRows) {
-        if (StartsWith(model, r.prefix)) {
-            if (thesis_name != nullptr) *thesis_name = r.name;
-            return r.lines;
-        }
-    }
-    return -1;
+    // Seed 003 section 12.4, "significant lines of code", as each model declares it.
+    const ModelInfo* info = RegisteredInfo(model);
+    if (info == nullptr || info->thesis_lines < 0) return -1;
+    if (thesis_name != nullptr) *thesis_name = info->thesis_name;
+    return info->thesis_lines;
 }
 
 ModelLoc CountModelLoc(const std::string& source_dir, const std::string& name) {

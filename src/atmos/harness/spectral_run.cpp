@@ -70,7 +70,7 @@ uint64_t BatchSeed(uint64_t seed, size_t batch, BatchSeeds seeds) {
     return seeds == BatchSeeds::kSame ? seed : seed + (static_cast<uint64_t>(batch) << 40);
 }
 
-bool HasSpectralForm(const ModelInfo& info) { return info.name != "neural"; }
+bool HasSpectralForm(const ModelInfo& info) { return info.capabilities.spectral; }
 
 void RequireSpectralModel(const ModelInfo& info) {
     if (!HasSpectralForm(info)) {

@@ -39,6 +39,20 @@ ATMOS_HD inline void AplusItemTexel(int64_t i, const AplusSettings& s, int* x, i
     *z = static_cast<int>(i / (static_cast<int64_t>(s.width) * s.height));
 }
 
+// The opening of every per-texel stage: the texel of item `i` of the scattering
+// table and the (h, mu, mu_s) it stands for (AplusTexelParameters).
+struct AplusTexel {
+    int x, y, z;
+    double h, mu, mu_s;
+};
+ATMOS_HD inline AplusTexel AplusTexelOf(int64_t i, const AplusSettings& s) {
+    AplusTexel t;
+    AplusItemTexel(i, s, &t.x, &t.y, &t.z);
+    AplusTexelParameters(s.mapping, t.x, t.y, t.z, s.width, s.height, s.depth, &t.h, &t.mu,
+                         &t.mu_s);
+    return t;
+}
+
 // Seed 000 sections 2.2, 2.3: the factored order k from the gather table of
 // order k-1: beta/(4 pi) int G(P, V, L) p(h) T(P, P_a) ds, trapezoidal rule
 // with transmittance_steps intervals along the view segment.
@@ -130,10 +144,7 @@ struct AplusSingleScatteringStage {
         v(out);
     }
     ATMOS_HD void operator()(int64_t i) const {
-        int x, y, z;
-        AplusItemTexel(i, s, &x, &y, &z);
-        double h, mu, mu_s;
-        AplusTexelParameters(s.mapping, x, y, z, s.width, s.height, s.depth, &h, &mu, &mu_s);
+        const auto [x, y, z, h, mu, mu_s] = AplusTexelOf(i, s);
         out.Set(x, y, z,
                 AplusToVec4f(AplusSingleScattering(atm, h, mu, mu_s, s.transmittance_steps,
                                                    s.transmittance_steps)));
@@ -165,10 +176,7 @@ struct AplusGatherStage {
         v(out);
     }
     ATMOS_HD void operator()(int64_t i) const {
-        int x, y, z;
-        AplusItemTexel(i, s, &x, &y, &z);
-        double h, mu, mu_s;
-        AplusTexelParameters(s.mapping, x, y, z, s.width, s.height, s.depth, &h, &mu, &mu_s);
+        const auto [x, y, z, h, mu, mu_s] = AplusTexelOf(i, s);
         const int n = s.gather_theta, m = s.gather_phi;
         const double d_theta = kPi / n;
         const double d_phi = 2.0 * kPi / m;
@@ -216,10 +224,7 @@ struct AplusOrderStage {
         v(out);
     }
     ATMOS_HD void operator()(int64_t i) const {
-        int x, y, z;
-        AplusItemTexel(i, s, &x, &y, &z);
-        double h, mu, mu_s;
-        AplusTexelParameters(s.mapping, x, y, z, s.width, s.height, s.depth, &h, &mu, &mu_s);
+        const auto [x, y, z, h, mu, mu_s] = AplusTexelOf(i, s);
         out.Set(x, y, z, AplusToVec4f(AplusOrderFromGather(gather, atm, s, h, mu, mu_s)));
     }
 };

@@ -43,6 +43,38 @@ ATMOS_HD inline void BrunetonTexelOf(int64_t item, int width, int height, int* x
     *z = static_cast<int>(row / height);
 }
 
+// The opening of the per-texel stages of the scattering tables: the texel of
+// `item` in a `width` x `height` x depth table and the (r, mu, mu_s, nu) it
+// stands for, with whether its view ray hits the ground (seed 004
+// GetRMuMuSNuFromScatteringTextureFragCoord).
+struct BrunetonScatteringTexel {
+    int x, y, z;
+    double r, mu, mu_s, nu;
+    bool ground;
+};
+ATMOS_HD inline BrunetonScatteringTexel BrunetonScatteringTexelOf(const BrunetonLut& lut,
+                                                                  int64_t item, int width,
+                                                                  int height) {
+    BrunetonScatteringTexel t;
+    BrunetonTexelOf(item, width, height, &t.x, &t.y, &t.z);
+    lut.RMuMuSNuFromTexel(t.x, t.y, t.z, &t.r, &t.mu, &t.mu_s, &t.nu, &t.ground);
+    return t;
+}
+
+// The view ray of a scattering texel: n = scattering_samples steps of dx to
+// the nearest boundary, and whether any is optically thick (RayHasThickSteps).
+struct BrunetonViewSteps {
+    int n;
+    double dx;
+    bool thick;
+};
+ATMOS_HD inline BrunetonViewSteps BrunetonViewStepsOf(const BrunetonLut& lut, double r, double mu,
+                                                      bool ground) {
+    const int n = lut.cfg.scattering_samples;
+    const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
+    return {n, dx, RayHasThickSteps(lut.atm, r, mu, dx, n)};
+}
+
 // The lookup `lut` with no tables: the mappings only (a stage that needs no
 // table of the lut then copies none to the device).
 inline BrunetonLut BrunetonMappingsOnly(const BrunetonLut& lut) {
@@ -150,14 +182,9 @@ struct BrunetonSingleScatteringStage {
         v(mie);
     }
     ATMOS_HD void operator()(int64_t item) const {
-        int x, y, z;
-        BrunetonTexelOf(item, rayleigh.width, rayleigh.height, &x, &y, &z);
-        double r, mu, mu_s, nu;
-        bool ground;
-        lut.RMuMuSNuFromTexel(x, y, z, &r, &mu, &mu_s, &nu, &ground);
-        const int n = lut.cfg.scattering_samples;
-        const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
-        const bool thick = RayHasThickSteps(lut.atm, r, mu, dx, n);
+        const auto [x, y, z, r, mu, mu_s, nu, ground] =
+            BrunetonScatteringTexelOf(lut, item, rayleigh.width, rayleigh.height);
+        const auto [n, dx, thick] = BrunetonViewStepsOf(lut, r, mu, ground);
         ThickRayWeights weights(r, mu, dx, n);
         Rgb sum_r, sum_m;
         for (int i = 0; i <= n; ++i) {
@@ -351,12 +378,9 @@ struct BrunetonDensityStage {
         v(density);
     }
     ATMOS_HD void operator()(int64_t item) const {
-        int x, y, z;
-        BrunetonTexelOf(item, density.width, density.height, &x, &y, &z);
+        const auto [x, y, z, r, mu, mu_s, nu, ground] =
+            BrunetonScatteringTexelOf(lut, item, density.width, density.height);
         const AtmosphereParameters& atm = lut.atm;
-        double r, mu, mu_s, nu;
-        bool ground;
-        lut.RMuMuSNuFromTexel(x, y, z, &r, &mu, &mu_s, &nu, &ground);
         // The view direction omega with omega.z = mu and omega.omega_s = nu, in
         // the frame where omega_s = (sin_s, 0, mu_s).
         const double sin_s = SafeSqrt(1.0 - mu_s * mu_s);
@@ -552,18 +576,13 @@ struct BrunetonMultipleScatteringStage {
         v(out);
     }
     ATMOS_HD void operator()(int64_t item) const {
-        int x, y, z;
-        BrunetonTexelOf(item, out.width, out.height, &x, &y, &z);
-        double r, mu, mu_s, nu;
-        bool ground;
-        lut.RMuMuSNuFromTexel(x, y, z, &r, &mu, &mu_s, &nu, &ground);
-        const int n = lut.cfg.scattering_samples;
-        const double dx = lut.DistanceToNearestAtmosphereBoundary(r, mu, ground) / n;
+        const auto [x, y, z, r, mu, mu_s, nu, ground] =
+            BrunetonScatteringTexelOf(lut, item, out.width, out.height);
+        const auto [n, dx, thick] = BrunetonViewStepsOf(lut, r, mu, ground);
         const BrunetonFastLookup fast(lut, density);
         double tex_x;
         float lerp;
         BrunetonNuCoordinate(nu, lut.cfg.scattering_nu, &tex_x, &lerp);
-        const bool thick = RayHasThickSteps(lut.atm, r, mu, dx, n);
         ThickRayWeights weights(r, mu, dx, n);
         Rgb sum;
         for (int i = 0; i <= n; ++i) {
@@ -592,11 +611,8 @@ struct BrunetonAccumulateStage {
         v(scattering);
     }
     ATMOS_HD void operator()(int64_t item) const {
-        int x, y, z;
-        BrunetonTexelOf(item, scattering.width, scattering.height, &x, &y, &z);
-        double r, mu, mu_s, nu;
-        bool ground;
-        lut.RMuMuSNuFromTexel(x, y, z, &r, &mu, &mu_s, &nu, &ground);
+        const auto [x, y, z, r, mu, mu_s, nu, ground] =
+            BrunetonScatteringTexelOf(lut, item, scattering.width, scattering.height);
         const float inv_phase = static_cast<float>(1.0 / RayleighPhase(nu));
         const float* dm = delta.data + static_cast<size_t>(item) * 3;
         float* s = scattering.Texel(x, y, z);

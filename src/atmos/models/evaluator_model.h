@@ -75,8 +75,10 @@ class SimpleEvaluatorModel : public EvaluatorModel<Derived> {
   protected:
     static constexpr bool kInEvaluator = HoldsAtmosphere<Evaluator>::value;
     SimpleEvaluatorModel() : info_(Derived::StaticInfo()) { SetAtmosphere(EarthAtmosphere()); }
-    // The one place the model's atmosphere is stored.
+    // The one place the model's atmosphere is stored (Prepare() calls it):
+    // warns outside the model's declared ValidityDomain (atmos/model.h).
     void SetAtmosphere(const AtmosphereParameters& atmosphere) {
+        WarnOutsideValidityDomain(info_, atmosphere);
         if constexpr (kInEvaluator) {
             evaluator_.atm = atmosphere;
         } else {

@@ -12,6 +12,8 @@ ModelInfo FlatModel::StaticInfo() {
     info.summary =
         "closed-form single scattering over one segment, homogeneous-sphere optical depth, "
         "ozone shell";
+    info.thesis_name = "Flat";
+    info.thesis_lines = 58;
     return info;
 }
 

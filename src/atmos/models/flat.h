@@ -35,6 +35,7 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
+#include "models/analytic_ray.h"
 #include "models/evaluator_model.h"
 #include "physics/analytic_media.h"
 #include "physics/analytic_optical_depth.h"
@@ -83,15 +84,6 @@ struct FlatOptics {
         const double l_o = ShellLength(m.ozone, p, sun, 0.0, 4.0 * m.top);
         return m.Extinction(l_r, l_m, l_o);
     }
-
-    // Direct sunlight reflected by a Lambertian ground at p, attenuated by
-    // t_view (per unit solar irradiance).
-    ATMOS_HD Rgb Ground(const Vec3d& p, const Vec3d& sun, const Vec3d& t_view) const {
-        if (MaxComponent(m.ground_albedo) <= 0.0) return Rgb(0.0f);
-        const double cos_sun = Dot(Normalize(p), sun);
-        if (cos_sun <= 0.0) return Rgb(0.0f);
-        return Rgb(m.ground_albedo * (cos_sun / kPi) * Exp(-LightDepth(p, sun)) * t_view);
-    }
 };
 
 struct FlatEvaluator {
@@ -102,12 +94,7 @@ struct FlatEvaluator {
         const AnalyticMedia& m = optics.m;
         RayResult out;
         AtmosphereSegment seg;
-        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) {
-            // A camera on the ground looking down (physics/ray.h): the ground at the camera.
-            if (want_ground && GroundAtCamera(seg))
-                out.ground = optics.Ground(camera, sun, Vec3d(1.0));
-            return out;
-        }
+        if (!BeginAnalyticRay(optics, camera, dir, sun, want_ground, &out, &seg)) return out;
         const MediaLengths l = optics.SegmentLengths(camera, dir, seg.t_start, seg.t_end);
         const Vec3d tau = m.Extinction(l.rayleigh, l.mie, l.ozone);
         const Vec3d p0 = camera + dir * seg.t_start;
@@ -122,7 +109,7 @@ struct FlatEvaluator {
         const Vec3d t_view = Exp(-tau);
         out.sky = Rgb(sky);
         out.transmittance = Rgb(t_view);
-        if (want_ground && seg.hits_ground) out.ground = optics.Ground(p1, sun, t_view);
+        if (want_ground && seg.hits_ground) out.ground = AnalyticGround(optics, p1, sun, t_view);
         return out;
     }
 };

@@ -11,6 +11,8 @@ ModelInfo NaiveModel::StaticInfo() {
     info.summary = "single scattering by nested numerical integration, Rayleigh + Mie + ozone";
     info.capabilities.multiple_scattering = false;
     info.options = OptionRows().Specs();
+    info.thesis_name = "Naive";
+    info.thesis_lines = 118;
     return info;
 }
 

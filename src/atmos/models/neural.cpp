@@ -348,6 +348,10 @@ ModelInfo NeuralModel::StaticInfo() {
     info.capabilities.multiple_scattering = true;
     info.capabilities.precomputed = true;
     info.options = OptionRows().Specs();
+    info.capabilities.spectral = false;  // its inputs are fitted weights, not coefficients
+    info.capabilities.trainable = true;
+    info.thesis_name = "Neural network";
+    info.thesis_lines = 94;
     return info;
 }
 

@@ -51,6 +51,7 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
+#include "models/analytic_ray.h"
 #include "models/evaluator_model.h"
 #include "physics/analytic_media.h"
 #include "physics/analytic_optical_depth.h"
@@ -151,17 +152,7 @@ struct OneilEvaluator {
         const AnalyticMedia& m = optics.m;
         RayResult out;
         AtmosphereSegment seg;
-        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) {
-            // A camera on the ground looking down (physics/ray.h): the ground at the camera.
-            if (want_ground && GroundAtCamera(seg) && MaxComponent(m.ground_albedo) > 0.0) {
-                const double cos_sun = Dot(Normalize(camera), sun);
-                if (cos_sun > 0.0) {
-                    out.ground = Rgb(m.ground_albedo * (cos_sun / kPi) *
-                                     Exp(-optics.LightDepth(camera, sun)));
-                }
-            }
-            return out;
-        }
+        if (!BeginAnalyticRay(optics, camera, dir, sun, want_ground, &out, &seg)) return out;
         const Vec3d p0 = camera + dir * seg.t_start;
         const double r0 = Length(p0);
         const double mu0 = ClampCosine(Dot(p0, dir) / r0);
@@ -195,20 +186,8 @@ struct OneilEvaluator {
             sum_r += attenuation * (rho_r * ds);
             sum_m += attenuation * (rho_m * ds);
         }
-        const double nu = dir_sun;
-        const Vec3d sky = m.rayleigh_scattering * sum_r * RayleighPhase(nu) +
-                          m.mie_scattering * sum_m * m.MiePhaseAt(nu);
-        const Vec3d t_view = Exp(-optics.SegmentDepth(camera, dir, seg.t_start, seg.t_end));
-        out.sky = Rgb(sky);
-        out.transmittance = Rgb(t_view);
-        if (want_ground && seg.hits_ground && MaxComponent(m.ground_albedo) > 0.0) {
-            const Vec3d g = camera + dir * seg.t_end;
-            const double cos_sun = Dot(Normalize(g), sun);
-            if (cos_sun > 0.0) {
-                out.ground = Rgb(m.ground_albedo * (cos_sun / kPi) *
-                                 Exp(-optics.LightDepth(g, sun)) * t_view);
-            }
-        }
+        FinishAnalyticRay(optics, camera, dir, sun, seg, want_ground, dir_sun, sum_r, sum_m,
+                          Exp(-optics.SegmentDepth(camera, dir, seg.t_start, seg.t_end)), &out);
         return out;
     }
 };

@@ -87,6 +87,8 @@ ModelInfo PreethamModel::StaticInfo() {
     info.capabilities.sun_below_horizon = false;
     info.capabilities.multiple_scattering = true;  // fitted to a full simulation
     info.options = OptionRows().Specs();
+    info.thesis_name = "Preetham, Shirley and Smits";
+    info.thesis_lines = 58;
     return info;
 }
 

@@ -11,6 +11,8 @@ ModelInfo RaymarchedModel::StaticInfo() {
         "single scattering summed over a few closed-form segments (Eq. 55), flat optical "
         "depth, ozone shell";
     info.options = OptionRows().Specs();
+    info.thesis_name = "Raymarched";
+    info.thesis_lines = 74;
     return info;
 }
 

@@ -37,12 +37,7 @@ struct RaymarchedEvaluator {
         const AnalyticMedia& m = optics.m;
         RayResult out;
         AtmosphereSegment seg;
-        if (!BeginRay(camera, dir, m.bottom, m.top, &out, &seg)) {
-            // A camera on the ground looking down (physics/ray.h): the ground at the camera.
-            if (want_ground && GroundAtCamera(seg))
-                out.ground = optics.Ground(camera, sun, Vec3d(1.0));
-            return out;
-        }
+        if (!BeginAnalyticRay(optics, camera, dir, sun, want_ground, &out, &seg)) return out;
         const double dt = (seg.t_end - seg.t_start) / steps;
         Vec3d tau_view;  // camera to the start of the current part
         Vec3d light_a = optics.LightDepth(camera + dir * seg.t_start, sun);
@@ -59,15 +54,8 @@ struct RaymarchedEvaluator {
             tau_view += tau_i;
             light_a = light_b;
         }
-        const double nu = Dot(dir, sun);
-        const Vec3d sky = m.rayleigh_scattering * sum_r * RayleighPhase(nu) +
-                          m.mie_scattering * sum_m * m.MiePhaseAt(nu);
-        const Vec3d t_view = Exp(-tau_view);
-        out.sky = Rgb(sky);
-        out.transmittance = Rgb(t_view);
-        if (want_ground && seg.hits_ground) {
-            out.ground = optics.Ground(camera + dir * seg.t_end, sun, t_view);
-        }
+        FinishAnalyticRay(optics, camera, dir, sun, seg, want_ground, Dot(dir, sun), sum_r, sum_m,
+                          Exp(-tau_view), &out);
         return out;
     }
 };

@@ -187,6 +187,8 @@ ModelInfo ReferenceModel::StaticInfo() {
     info.capabilities.multiple_scattering = true;
     info.capabilities.stochastic = true;
     info.options = OptionRows().Specs();
+    info.thesis_name = "Path tracer";
+    info.thesis_lines = 147;
     return info;
 }
 

@@ -1,4 +1,5 @@
 // atmos: the registry of models, built from THE list (models/model_list.h).
+#include <deque>
 #include <functional>
 #include <memory>
 #include <string>
@@ -8,52 +9,33 @@
 
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "models/model_factory.h"
 #include "models/model_list.h"
 
 namespace atmos {
 
 namespace {
 
-// Each model M provides `static ModelInfo StaticInfo()`, an options struct O,
-// `static const OptionTable<O>& OptionRows()` and a constructor from O: the registry parses and
-// validates the user's option text through the table, once, and hands the model its typed struct.
 struct Entry {
-    std::function<ModelInfo()> info;
-    std::function<std::unique_ptr<Model>(const std::string&,
-                                         const std::map<std::string, std::string>&)>
-        create;
-    std::function<std::vector<std::pair<std::string, std::string>>(
-        const std::string&, const std::map<std::string, std::string>&)>
-        resolve;
+    ModelInfo info;
+    ModelFactory factory;
+    bool runtime = false;  // RegisterModel
 };
 
-template <typename M>
-Entry MakeEntry() {
-    return {[] { return M::StaticInfo(); },
-            [](const std::string& name, const std::map<std::string, std::string>& given) {
-                return std::unique_ptr<Model>(new M(M::OptionRows().Parse(name, given)));
-            },
-            [](const std::string& name, const std::map<std::string, std::string>& given) {
-                return M::OptionRows().Values(M::OptionRows().Parse(name, given));
-            }};
-}
-
-const std::vector<Entry>& Registry() {
-    static const std::vector<Entry> entries = {
-#define ATMOS_REGISTRY_ENTRY(M, E) MakeEntry<M>(),
-        ATMOS_MODELS(ATMOS_REGISTRY_ENTRY)
+// A deque: references to an entry's info (GetModelInfo) stay valid while
+// others are appended or removed at the end.
+std::deque<Entry>& Registry() {
+    static std::deque<Entry> entries = [] {
+        std::deque<Entry> v;
+        const ModelFactory listed[] = {
+#define ATMOS_REGISTRY_ENTRY(M, E) ModelFactoryOf<M>(),
+            ATMOS_MODELS(ATMOS_REGISTRY_ENTRY)
 #undef ATMOS_REGISTRY_ENTRY
-    };
-    return entries;
-}
-
-const std::vector<ModelInfo>& Infos() {
-    static const std::vector<ModelInfo> infos = [] {
-        std::vector<ModelInfo> v;
-        for (const Entry& e : Registry()) v.push_back(e.info());
+        };
+        for (const ModelFactory& f : listed) v.push_back({f.info(), f, false});
         return v;
     }();
-    return infos;
+    return entries;
 }
 
 }  // namespace
@@ -67,7 +49,30 @@ ModelInfo EmptyModel::StaticInfo() {
     return info;
 }
 
-std::vector<ModelInfo> ListModels() { return Infos(); }
+std::vector<ModelInfo> ListModels() {
+    std::vector<ModelInfo> v;
+    for (const Entry& e : Registry()) v.push_back(e.info);
+    return v;
+}
+
+void RegisterModel(const ModelFactory& factory) {
+    ModelInfo info = factory.info();
+    for (const Entry& e : Registry()) {
+        if (e.info.name == info.name) Fail("model '", info.name, "' is already registered");
+    }
+    Registry().push_back({std::move(info), factory, true});
+}
+
+void UnregisterModel(const std::string& name) {
+    std::deque<Entry>& r = Registry();
+    for (auto it = r.begin(); it != r.end(); ++it) {
+        if (it->info.name != name) continue;
+        if (!it->runtime) Fail("model '", name, "' is in THE list (models/model_list.h)");
+        r.erase(it);
+        return;
+    }
+    Fail("unknown model '", name, "'");
+}
 
 bool HasDeviceKernels(const std::type_info& evaluator) {
     static const std::vector<std::type_index> listed = {
@@ -81,33 +86,27 @@ bool HasDeviceKernels(const std::type_info& evaluator) {
     return false;
 }
 
-const ModelInfo& GetModelInfo(const std::string& name) {
-    for (const ModelInfo& info : Infos()) {
-        if (info.name == name) return info;
-    }
-    std::string list;
-    for (const ModelInfo& info : Infos()) list += (list.empty() ? "" : ", ") + info.name;
-    Fail("unknown model '", name, "' (models: ", list, ")");
-}
-
 namespace {
 const Entry& EntryOf(const std::string& name) {
-    const ModelInfo& info = GetModelInfo(name);
-    for (size_t i = 0; i < Infos().size(); ++i) {
-        if (Infos()[i].name == info.name) return Registry()[i];
+    for (const Entry& e : Registry()) {
+        if (e.info.name == name) return e;
     }
-    Fail("unknown model '", name, "'");
+    std::string list;
+    for (const Entry& e : Registry()) list += (list.empty() ? "" : ", ") + e.info.name;
+    Fail("unknown model '", name, "' (models: ", list, ")");
 }
 }  // namespace
 
+const ModelInfo& GetModelInfo(const std::string& name) { return EntryOf(name).info; }
+
 std::unique_ptr<Model> CreateModel(const std::string& name,
                                    const std::map<std::string, std::string>& options) {
-    return EntryOf(name).create(GetModelInfo(name).name, options);
+    return EntryOf(name).factory.create(options);
 }
 
 std::vector<std::pair<std::string, std::string>> ResolveModelOptions(
     const std::string& name, const std::map<std::string, std::string>& given) {
-    return EntryOf(name).resolve(GetModelInfo(name).name, given);
+    return EntryOf(name).factory.resolve(given);
 }
 
 }  // namespace atmos

@@ -11,6 +11,8 @@ ModelInfo TransmittanceOneilModel::StaticInfo() {
     info.capabilities = TransmittanceCapabilities();
     info.capabilities.precomputed = true;
     info.options = OptionRows().Specs();
+    // The optical depth of `oneil` (its domain, measured there).
+    info.domain = OneilModel::StaticInfo().domain;
     return info;
 }
 
