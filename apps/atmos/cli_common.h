@@ -91,6 +91,7 @@ struct Command {
 Command AddListCommand(CLI::App* root);
 Command AddRenderCommand(CLI::App* root);
 Command AddSampleCommand(CLI::App* root);
+Command AddIrradianceCommand(CLI::App* root);
 Command AddBakeCommand(CLI::App* root);
 Command AddViewerCommand(CLI::App* root);
 Command AddFlipCommand(CLI::App* root);

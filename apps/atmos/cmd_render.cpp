@@ -37,6 +37,9 @@ struct RenderOptions {
     std::string quantity = "radiance";
     std::string output;
     bool sun_disc = false;
+    std::string camera;  // --camera KEY=VALUE,... (a free camera, docs/views.md)
+    std::string sun;     // --sun elevation=DEG,azimuth=DEG
+    bool view_given = false;
     float exposure = 0.0f;   // 0: the view's
     std::string checkpoint;  // Monte Carlo models: checkpoint stem (default: OUTPUT.ckpt)
     bool resume = false;
@@ -107,6 +110,17 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     const Quantity quantity = ParseQuantity(ro.quantity);
     if (ro.output.empty()) Fail("render needs an output: -o FILE (or -o DIR with --view all)");
     const bool all_views = ro.view == "all";
+    // A free camera and sun (--camera, --sun): checked before any work.
+    const bool custom = !ro.camera.empty() || !ro.sun.empty();
+    CameraSpec camera_spec;
+    Vec3d sun_direction;
+    if (custom) {
+        if (ro.view_given) Fail("--view cannot be combined with --camera or --sun");
+        if (ro.sun.empty()) Fail("--camera needs --sun elevation=DEG,azimuth=DEG");
+        if (!ro.camera.empty()) camera_spec = ParseCameraSpec(ro.camera);
+        CheckCameraSpec(camera_spec, width, height);
+        sun_direction = ParseSunSpec(ro.sun);
+    }
     if (!all_views) ImageFormatFromPath(ro.output);  // fail before the work on a bad name
     // The output is writable before any work (io/output_path.h).
     if (all_views) {
@@ -129,7 +143,9 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     MonteCarloSettings monte_carlo = ro.monte_carlo.Settings(model->Info());
     monte_carlo.checkpoint_seconds = ro.checkpoint_every;
     std::vector<View> views;
-    if (all_views) {
+    if (custom) {
+        views.push_back(CustomView(camera_spec, sun_direction, atmosphere));
+    } else if (all_views) {
         views = StandardViews(atmosphere);
     } else {
         views.push_back(GetView(ro.view, atmosphere));
@@ -223,7 +239,19 @@ Command AddRenderCommand(CLI::App* root) {
     AddCommonOptions(render, common.get());
     AddBackendOption(render, &common->backend);
     render->add_option("--view,-v", ro->view, "view name, or 'all' (-o is then a directory)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->each([ro](const std::string&) { ro->view_given = true; });
+    render->add_option("--camera", ro->camera,
+                       "a free camera instead of --view: KEY=VALUE[,...] with altitude (m above "
+                       "the ground), azimuth (deg clockwise from north), elevation, roll, fov "
+                       "(vertical, deg), projection=perspective|equirect (2:1)|fisheye|cubemap "
+                       "(6:1 strip +X,-X,+Y,-Y,+Z,-Z)|equal-area (square, pbrt-v4); default "
+                       "perspective at the ground looking north at the horizon, fov 60 "
+                       "(docs/views.md); needs --sun");
+    render->add_option("--sun", ro->sun,
+                       "the sun for --camera: elevation=DEG[,azimuth=DEG] (azimuth clockwise from "
+                       "north, default 0); radiance is then per unit solar irradiance times the "
+                       "atmosphere's solar_irradiance");
     render->add_option("--size,-s", ro->size, "image size WIDTHxHEIGHT")->capture_default_str();
     render->add_option("--quantity", ro->quantity, "radiance or transmittance")
         ->capture_default_str();

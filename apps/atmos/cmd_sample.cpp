@@ -205,6 +205,8 @@ void WriteAnswers(const std::string& output, const std::vector<SampleQuery>& que
 
 struct SampleIo {
     std::string input, output;
+    bool ground = false;    // --ground: the lit ground's radiance as a render shows it
+    bool sun_disc = false;  // --sun-disc: the sun's disc as a render shows it
 };
 
 int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const SampleIo& io,
@@ -212,22 +214,27 @@ int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const S
     ThreadLimit limit(common.threads);
     const BackendScope backend(ParseBackend(common.backend));
     if (!spectral.wavelengths.empty()) {
+        if (io.sun_disc) Fail("--sun-disc cannot be combined with --wavelengths");
         ParseWavelengths(spectral.wavelengths);  // fail before reading stdin
         const MonteCarloSettings mc = flags.Settings(CreateModel(GivenModel(common))->Info());
         const bool npy = !io.output.empty() && io.output != "-" && IsNpyPath(io.output);
         const SpectralBatching batching = ParseSpectralBatching(spectral);
-        return SampleSpectralCsv(common, mc, spectral.wavelengths, ReadQueries(io.input), batching,
-                                 io.output, npy);
+        std::vector<SampleQuery> queries = ReadQueries(io.input);
+        for (SampleQuery& q : queries) q.ground = io.ground ? 1 : 0;
+        return SampleSpectralCsv(common, mc, spectral.wavelengths, queries, batching, io.output,
+                                 npy);
     }
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(GivenModel(common));
     const MonteCarloSettings monte_carlo = flags.Settings(model->Info());
-    const std::vector<SampleQuery> queries = ReadQueries(io.input);
+    std::vector<SampleQuery> queries = ReadQueries(io.input);
+    for (SampleQuery& q : queries) q.ground = io.ground ? 1 : 0;
     PrepareModel(common, atmosphere, model.get());
     const LibraryProgressScope progress(!common.quiet);  // long batches show a bar
-    const std::vector<SampleAnswer> answers = model->Info().capabilities.stochastic
-                                                  ? SampleMonteCarlo(*model, queries, monte_carlo)
-                                                  : model->Sample(queries);
+    std::vector<SampleAnswer> answers = model->Info().capabilities.stochastic
+                                            ? SampleMonteCarlo(*model, queries, monte_carlo)
+                                            : model->Sample(queries);
+    if (io.sun_disc) AddSunDisc(queries, atmosphere, &answers);
     WriteAnswers(io.output, queries, answers);
     return 0;
 }
@@ -252,6 +259,12 @@ Command AddSampleCommand(CLI::App* root) {
         "--output,-o", io->output,
         "answers: a CSV file, or NPY (float32, shape (N, 6): L_r,L_g,L_b,T_r,T_g,T_b) "
         "(default: CSV to stdout)");
+    c.app->add_flag("--ground", io->ground,
+                    "add the lit ground's reflected radiance (attenuated along the ray) to rays "
+                    "that hit the ground, as render shows it");
+    c.app->add_flag("--sun-disc", io->sun_disc,
+                    "add the sun's disc (T / (pi alpha^2) per unit irradiance inside its angular "
+                    "radius alpha) as render --sun-disc shows it");
     AddSpectralFlags(c.app, spectral.get(), false);
     c.run = [common, flags, io, spectral] { return CmdSample(*common, *flags, *io, *spectral); };
     return c;

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
         AddListCommand(&app),
         AddRenderCommand(&app),
         AddSampleCommand(&app),
+        AddIrradianceCommand(&app),
         AddBakeCommand(&app),
         AddViewerCommand(&app),
         AddFlipCommand(&app),

@@ -114,9 +114,16 @@ struct SampleQuery {
     double mu = 1.0;
     double mu_s = 1.0;
     double azimuth_deg = 0.0;
+    // `sample --ground`: add the lit ground's reflected radiance, attenuated
+    // along the ray, as a render's pixel shows it (the model is then asked as a
+    // render asks it, want_ground = true).
+    int32_t ground = 0;
+    int32_t padding = 0;
 };
-// Sky radiance per unit solar irradiance (scattered light only: no sun disc, no
-// ground), and the view ray's transmittance to space (0 when it hits the ground).
+// Sky radiance per unit solar irradiance (scattered light only: no sun disc;
+// no ground unless the query asks for it), and the view ray's transmittance to
+// space (0 when it hits the ground). AddSunDisc (render/render.h) adds the
+// sun's disc as a render does.
 struct SampleAnswer {
     Rgb radiance;
     Rgb transmittance;
@@ -185,6 +192,14 @@ struct RenderRequest {
     MonteCarloReport* report = nullptr;  // optional: filled by a Monte Carlo render
 };
 
+// `sample --sun-disc`: adds the sun's disc to each answer as a free render's
+// pixel shows it (per unit irradiance: T / (pi alpha^2) times the limb
+// darkening's factor where the ray sees the disc and misses the ground; alpha =
+// the atmosphere's sun_angular_radius; limb_darkening as View's, 0: uniform;
+// defined in render/render.cpp).
+void AddSunDisc(const std::vector<SampleQuery>& queries, const AtmosphereParameters& atmosphere,
+                std::vector<SampleAnswer>* answers, double limb_darkening = kSunLimbDarkening);
+
 class Model {
   public:
     virtual ~Model() = default;
@@ -230,6 +245,14 @@ class Model {
     // -1 for a model without tables or before Prepare().
     virtual int64_t TableBytes() const { return -1; }
     virtual void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere);
+
+    // A model with a precomputed sky-irradiance table (bruneton) answers the
+    // sky's diffuse irradiance on a horizontal plane at `altitude_m` for the
+    // sun at cosine `mu_s` from it (per unit solar irradiance) and returns
+    // true; others return false (harness/irradiance.h integrates their sky).
+    virtual bool TableSkyIrradiance(double /*altitude_m*/, double /*mu_s*/, Rgb* /*out*/) const {
+        return false;
+    }
 };
 
 // Output values (NaN, infinity or negative) that the last guard of every render

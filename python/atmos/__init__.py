@@ -25,7 +25,7 @@ from . import _atmos
 from ._sun import sun_position
 
 __all__ = [
-    "Atmosphere", "Model", "FlipResult", "RmseResult", "models", "model_info", "views",
+    "Atmosphere", "Model", "Camera", "FlipResult", "RmseResult", "models", "model_info", "views",
     "view_names", "atmosphere_presets", "flip", "rmse", "bake", "read_image", "write_image",
     "set_threads", "thread_count", "sun_position", "to_srgb", "validate", "compare", "bench",
 ]
@@ -271,38 +271,109 @@ class Model:
         _os.makedirs(_os.fspath(directory), exist_ok=True)
         self._m.bake(_os.fspath(directory))
 
-    def sample(self, altitude, mu, mu_s, azimuth=0.0, *, spp=None, seed=None):
+    def sample(self, altitude, mu, mu_s, azimuth=0.0, *, spp=None, seed=None, ground=False,
+               sun_disc=False):
         """Radiance per unit solar irradiance and transmittance at queries of
         `atmos sample` (camera at altitude metres, view cosine mu, sun cosine
         mu_s, sun azimuth in degrees). The four arguments broadcast as NumPy
         arrays; returns (L, T), float32 arrays of the broadcast shape + (3,).
         float64 arrays are read in place (any strides); the GIL is released.
-        Monte Carlo models take spp (paths per query) and seed."""
+        Monte Carlo models take spp (paths per query) and seed. ground=True
+        adds the lit ground and sun_disc=True the sun's disc, as a rendered
+        pixel shows them (`atmos sample --ground --sun-disc`)."""
         args = [_np.asarray(a, dtype=_np.float64) for a in (altitude, mu, mu_s, azimuth)]
-        return self._m.sample(*args, spp=spp, seed=seed)
+        return self._m.sample(*args, spp=spp, seed=seed, ground=bool(ground),
+                              sun_disc=bool(sun_disc))
 
-    def render(self, view="ground-noon", size=(480, 270), *, quantity="radiance",
-               sun_disc=False, spp=None, seed=None, pass_spp=None, checkpoint=None,
-               resume=False, return_variance=False, progress=None):
-        """Renders a standard view: float32 array H x W x 3 (linear, as the
-        EXR of `atmos render`). Monte Carlo models (the reference) take spp,
-        seed, pass_spp, checkpoint (a file stem), resume and return_variance
-        (then returns (image, variance)); `progress` is a callable
-        progress(passes_done, passes) called after each pass, or True for a
-        tqdm bar when tqdm is installed."""
+    def irradiance(self, sun, altitude=0.0):
+        """The sun's direct and the sky's diffuse irradiance on a horizontal
+        plane at `altitude` metres (`atmos irradiance`): a dict with 'direct',
+        'diffuse' (the converged hemisphere integral of the model's radiance),
+        'diffuse_coarse' (the same at half the nodes), 'nodes' and
+        'diffuse_table' (bruneton's irradiance table, else None); RGB tuples
+        per unit solar irradiance times the atmosphere's solar_irradiance.
+        `sun` is (elevation_deg, azimuth_deg) or "elevation=DEG,azimuth=DEG"."""
+        return self._m.irradiance(_sun_text(sun), float(altitude))
+
+    def render(self, view="ground-noon", size=(480, 270), *, camera=None, sun=None,
+               quantity="radiance", sun_disc=False, spp=None, seed=None, pass_spp=None,
+               checkpoint=None, resume=False, return_variance=False, progress=None):
+        """Renders a standard view, or a free `camera` (atmos.Camera) with a
+        `sun` (elevation_deg, azimuth_deg): float32 array H x W x 3 (linear,
+        as the EXR of `atmos render`; docs/views.md gives the projections).
+        Monte Carlo models (the reference) take spp, seed, pass_spp,
+        checkpoint (a file stem), resume and return_variance (then returns
+        (image, variance)); `progress` is a callable progress(passes_done,
+        passes) called after each pass, or True for a tqdm bar when tqdm is
+        installed."""
         width, height = _check_render_args(view, size)
+        camera_text = ""
+        if camera is not None:
+            if not isinstance(camera, Camera):
+                raise ValueError("camera must be an atmos.Camera, got %r" % (camera,))
+            camera_text = camera.spec
+        sun_text = "" if sun is None else _sun_text(sun)
+        if camera is None and sun is not None:
+            camera_text = Camera().spec
         callback, bar = _progress_callback(progress)
         try:
             return self._m.render(
                 view, int(width), int(height), quantity, bool(sun_disc), spp, seed, pass_spp,
                 "" if checkpoint is None else _os.fspath(checkpoint), bool(resume),
-                bool(return_variance), callback)
+                bool(return_variance), callback, camera_text, sun_text)
         finally:
             if bar is not None:
                 bar.close()
 
     def __repr__(self):
         return f"atmos.Model({self.spec!r})"
+
+
+def _sun_text(sun):
+    if isinstance(sun, str):
+        return sun
+    try:
+        values = [float(v) for v in sun]
+    except TypeError:
+        raise ValueError("sun must be (elevation_deg, azimuth_deg), got %r" % (sun,)) from None
+    if len(values) not in (1, 2):
+        raise ValueError("sun must be (elevation_deg, azimuth_deg), got %r" % (sun,))
+    text = "elevation=%r" % values[0]
+    if len(values) == 2:
+        text += ",azimuth=%r" % values[1]
+    return text
+
+
+class Camera:
+    """A free camera (docs/views.md; the CLI's --camera): altitude (m above
+    the ground), azimuth (degrees clockwise from north), elevation, roll, fov
+    (perspective: vertical; fisheye: across the height) and projection
+    (perspective, equirect, fisheye, cubemap, equal-area). World frame: +x
+    east, +y north, +z up. ValueError names the argument and its range."""
+
+    _KEYS = ("altitude", "azimuth", "elevation", "roll", "fov")
+
+    def __init__(self, altitude=0.0, azimuth=None, elevation=None, roll=None, fov=None,
+                 projection="perspective"):
+        parts = []
+        for key, value in zip(self._KEYS, (altitude, azimuth, elevation, roll, fov)):
+            if value is None:
+                continue
+            try:
+                number = float(value)
+            except (TypeError, ValueError):
+                raise ValueError("camera %s must be a number, got %r" % (key, value)) from None
+            parts.append("%s=%r" % (key, number))
+        if not isinstance(projection, str):
+            raise ValueError("camera projection must be a string, got %r" % (projection,))
+        parts.append("projection=" + projection)
+        self.spec = ",".join(parts)
+        _atmos.check_camera(self.spec)
+        self.altitude, self.azimuth, self.elevation = altitude, azimuth, elevation
+        self.roll, self.fov, self.projection = roll, fov, projection
+
+    def __repr__(self):
+        return "atmos.Camera(%s)" % self.spec
 
 
 def _progress_callback(progress):

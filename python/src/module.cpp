@@ -27,6 +27,7 @@
 #include "atmos/sun_position.h"
 #include "atmos/view.h"
 #include "base/parallel.h"
+#include "harness/irradiance.h"
 #include "harness/table_cache.h"
 #include "metrics/flip.h"
 #include "metrics/rmse.h"
@@ -212,7 +213,8 @@ struct Operand {
 // arguments, answers as two float32 arrays of shape broadcast + (3,).
 py::tuple Sample(const PyModel& m, const py::array_t<double>& altitude,
                  const py::array_t<double>& mu, const py::array_t<double>& mu_s,
-                 const py::array_t<double>& azimuth, py::object spp, py::object seed) {
+                 const py::array_t<double>& azimuth, py::object spp, py::object seed, bool ground,
+                 bool sun_disc) {
     m.RequirePrepared();
     const Model& model = *m.model;
     const bool stochastic = model.Info().capabilities.stochastic;
@@ -292,6 +294,7 @@ py::tuple Sample(const PyModel& m, const py::array_t<double>& altitude,
             q.mu = v[1];
             q.mu_s = v[2];
             q.azimuth_deg = v[3];
+            q.ground = ground ? 1 : 0;
             for (py::ssize_t d = ndim - 1; d >= 0; --d) {
                 const size_t u = static_cast<size_t>(d);
                 for (int k = 0; k < 4; ++k) p[k] += ops[k].strides[u];
@@ -301,8 +304,9 @@ py::tuple Sample(const PyModel& m, const py::array_t<double>& altitude,
             }
         }
         if (error.empty()) {
-            const std::vector<SampleAnswer> answers =
+            std::vector<SampleAnswer> answers =
                 stochastic ? SampleMonteCarlo(model, queries, mc) : model.Sample(queries);
+            if (sun_disc) AddSunDisc(queries, m.atmosphere, &answers);
             for (size_t i = 0; i < answers.size(); ++i) {
                 const SampleAnswer& a = answers[i];
                 l_out[3 * i + 0] = a.radiance.x;
@@ -318,10 +322,27 @@ py::tuple Sample(const PyModel& m, const py::array_t<double>& altitude,
     return py::make_tuple(radiance, transmittance);
 }
 
+// Runs f, turning the CLI's flag names in an atmos::Error ("--camera fov ...")
+// into the Python argument names ("camera fov ...").
+template <typename F>
+auto PythonNames(F f) -> decltype(f()) {
+    try {
+        return f();
+    } catch (const Error& e) {
+        std::string text = e.what();
+        for (const char* flag : {"--camera", "--sun"}) {
+            const size_t at = text.find(flag);
+            if (at != std::string::npos) text.erase(at, 2);
+        }
+        throw Error(text);
+    }
+}
+
 py::object Render(const PyModel& m, const std::string& view_name, int width, int height,
                   const std::string& quantity, bool sun_disc, py::object spp, py::object seed,
                   py::object pass_spp, const std::string& checkpoint, bool resume,
-                  bool return_variance, py::object on_pass) {
+                  bool return_variance, py::object on_pass, const std::string& camera,
+                  const std::string& sun) {
     m.RequirePrepared();
     if (width < 1 || width > 16384 || height < 1 || height > 16384) {
         Fail("size (", width, ", ", height, "): each must be in [1, 16384]");
@@ -329,7 +350,19 @@ py::object Render(const PyModel& m, const std::string& view_name, int width, int
     const Model& model = *m.model;
     const bool stochastic = model.Info().capabilities.stochastic;
     RenderRequest request;
-    request.view = GetView(view_name, m.atmosphere);
+    if (!camera.empty() || !sun.empty()) {
+        // A free camera and sun (atmos.Camera, sun=(elevation, azimuth)).
+        if (sun.empty()) Fail("sun: a camera needs sun=(elevation_deg, azimuth_deg)");
+        const CameraSpec spec = PythonNames([&] { return ParseCameraSpec(camera); });
+        PythonNames([&] {
+            CheckCameraSpec(spec, width, height);
+            return 0;
+        });
+        const Vec3d direction = PythonNames([&] { return ParseSunSpec(sun); });
+        request.view = CustomView(spec, direction, m.atmosphere);
+    } else {
+        request.view = GetView(view_name, m.atmosphere);
+    }
     request.width = width;
     request.height = height;
     request.quantity = ParseQuantity(quantity);
@@ -476,11 +509,46 @@ PYBIND11_MODULE(_atmos, mod) {
             },
             py::arg("directory"))
         .def("sample", &Sample, py::arg("altitude"), py::arg("mu"), py::arg("mu_s"),
-             py::arg("azimuth"), py::arg("spp") = py::none(), py::arg("seed") = py::none())
+             py::arg("azimuth"), py::arg("spp") = py::none(), py::arg("seed") = py::none(),
+             py::arg("ground") = false, py::arg("sun_disc") = false)
         .def("render", &Render, py::arg("view"), py::arg("width"), py::arg("height"),
              py::arg("quantity"), py::arg("sun_disc"), py::arg("spp"), py::arg("seed"),
              py::arg("pass_spp"), py::arg("checkpoint"), py::arg("resume"),
-             py::arg("return_variance"), py::arg("on_pass"));
+             py::arg("return_variance"), py::arg("on_pass"), py::arg("camera") = "",
+             py::arg("sun") = "")
+        .def(
+            "irradiance",
+            [](const PyModel& m, const std::string& sun, double altitude) {
+                m.RequirePrepared();
+                const Vec3d d = PythonNames([&] { return ParseSunSpec(sun); });
+                const double elevation = std::asin(Clamp(d.z, -1.0, 1.0)) * (180.0 / kPi);
+                if (!std::isfinite(altitude) || altitude < 0.0) {
+                    Fail("altitude must be >= 0 m, got ", altitude);
+                }
+                HorizontalIrradiance e;
+                {
+                    py::gil_scoped_release release;
+                    e = ComputeHorizontalIrradiance(*m.model, m.atmosphere, altitude, elevation);
+                }
+                auto rgb = [](const Vec3d& v) { return py::make_tuple(v.x, v.y, v.z); };
+                py::dict out;
+                out["direct"] = rgb(e.direct);
+                out["diffuse"] = rgb(e.diffuse);
+                out["diffuse_coarse"] = rgb(e.diffuse_coarse);
+                out["nodes"] = py::make_tuple(e.mu_nodes, e.azimuth_nodes);
+                out["diffuse_table"] = e.has_table ? py::object(rgb(e.diffuse_table)) : py::none();
+                return out;
+            },
+            py::arg("sun"), py::arg("altitude"));
+    mod.def(
+        "check_camera",
+        [](const std::string& spec) {
+            PythonNames([&] {
+                CheckCameraSpec(ParseCameraSpec(spec), 0, 0);
+                return 0;
+            });
+        },
+        py::arg("spec"));
 
     mod.def(
         "flip",

@@ -135,6 +135,13 @@ BrunetonEvaluator BrunetonModel::MakeEvaluator() const {
     return e;
 }
 
+bool BrunetonModel::TableSkyIrradiance(double altitude_m, double mu_s, Rgb* out) const {
+    if (!prepared_) Fail("model bruneton: Prepare() or LoadBaked() must run before rendering");
+    const BrunetonLut lut = MakeBrunetonLut(atm_, config_, tables_);
+    *out = lut.GetIrradiance(lut.irradiance_table, atm_.bottom_radius + altitude_m, mu_s);
+    return true;
+}
+
 namespace {
 
 // The #defines shaders/bruneton.glsl reads (written to DIR/shaders/

@@ -815,6 +815,8 @@ class BrunetonModel : public EvaluatorModel<BrunetonModel> {
     void Bake(const std::string& directory) const override;
     int64_t TableBytes() const override;
     void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere) override;
+    // The irradiance table (seed 004 "Ground irradiance": indirect only).
+    bool TableSkyIrradiance(double altitude_m, double mu_s, Rgb* out) const override;
 
     const BrunetonConfig& config() const { return config_; }
     const BrunetonTables& tables() const { return tables_; }

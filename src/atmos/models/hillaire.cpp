@@ -226,9 +226,12 @@ void HillaireModel::Render(const RenderRequest& request, Image* out) const {
     // The model's tables stay on the device; the frame's are dropped after.
     ResidentScope scope(&resident_);
     scope.Keep(evaluator_);
-    const std::unique_ptr<HillaireFrame> frame =
-        BuildFrame(request.view.camera, request.view.sun_direction,
-                   static_cast<double>(request.width) / request.height, evaluator_.ground_from_ap);
+    const std::unique_ptr<HillaireFrame> frame = BuildFrame(
+        request.view.camera, request.view.sun_direction,
+        static_cast<double>(request.width) / request.height,
+        // The volume is a perspective frustum: other projections
+        // take the ground from the sky-view table, as sample does.
+        evaluator_.ground_from_ap && request.view.camera.projection == Projection::kPerspective);
     out->Resize(request.width, request.height);
     RenderImage(frame->Evaluator(), setup, out->View(), request.show_progress);
 }

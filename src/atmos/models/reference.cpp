@@ -372,6 +372,8 @@ std::shared_ptr<const Table> ReferenceModel::Order1Table(const PixelSetup& setup
                                c.up.y,
                                c.up.z,
                                c.tan_half_fov_y,
+                               static_cast<double>(c.projection),
+                               c.half_fov,
                                setup.sun_direction.x,
                                setup.sun_direction.y,
                                setup.sun_direction.z,

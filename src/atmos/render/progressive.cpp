@@ -61,6 +61,20 @@ nlohmann::json CheckpointKey(const Model& model, const RenderRequest& request, i
                      request.view.camera.position.z,    request.view.camera.forward.x,
                      request.view.camera.forward.y,     request.view.camera.forward.z,
                      request.view.camera.tan_half_fov_y};
+    if (request.view.camera.projection != Projection::kPerspective ||
+        request.view.name == "custom") {
+        // A free camera (--camera): its roll and projection too (the named
+        // views' keys stay as they were).
+        const Camera& c = request.view.camera;
+        key["camera_frame"] = {c.right.x,
+                               c.right.y,
+                               c.right.z,
+                               c.up.x,
+                               c.up.y,
+                               c.up.z,
+                               static_cast<double>(c.projection),
+                               c.half_fov};
+    }
     key["sun"] = {request.view.sun_direction.x, request.view.sun_direction.y,
                   request.view.sun_direction.z};
     key["irradiance"] = request.view.sun_irradiance;

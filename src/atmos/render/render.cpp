@@ -19,7 +19,34 @@ PixelSetup MakePixelSetup(const RenderRequest& request, const AtmosphereParamete
     const double alpha = atmosphere.sun_angular_radius;
     s.cos_sun_radius = std::cos(alpha);
     s.sun_disc_scale = static_cast<float>(1.0 / (kPi * alpha * alpha));
+    s.limb_darkening = request.view.sun_limb_darkening;
     return s;
+}
+
+void AddSunDisc(const std::vector<SampleQuery>& queries, const AtmosphereParameters& atmosphere,
+                std::vector<SampleAnswer>* answers, double limb_darkening) {
+    const PixelSetup unit = [&] {
+        RenderRequest request;
+        request.view.sun_irradiance = 1.0;
+        request.view.sun_limb_darkening = limb_darkening;
+        PixelSetup s = MakePixelSetup(request, atmosphere);
+        return s;
+    }();
+    for (size_t i = 0; i < queries.size() && i < answers->size(); ++i) {
+        Vec3d dir, sun;
+        SampleDirections(queries[i], &dir, &sun);
+        SampleAnswer& a = (*answers)[i];
+        // The transmittance is 0 for a ray that hits the ground: no disc.
+        const double c = Dot(dir, sun);
+        if (c >= unit.cos_sun_radius) {
+            // As ShadePixel with irradiance 1.
+            const double f = unit.limb_darkening == 0.0
+                                 ? 1.0
+                                 : SunLimbFactor(c, unit.cos_sun_radius, unit.limb_darkening);
+            a.radiance +=
+                a.transmittance * static_cast<float>(static_cast<double>(unit.sun_disc_scale) * f);
+        }
+    }
 }
 
 namespace {

@@ -48,13 +48,25 @@ struct PixelSetup {
     bool sun_disc = false;
     double cos_sun_radius = 1.0;  // cos(sun angular radius)
     float sun_disc_scale = 0.0f;  // 1 / (pi alpha^2): disc radiance per unit irradiance
+    double limb_darkening = 0.0;  // View::sun_limb_darkening (0: a uniform disc)
 };
+
+// The disc's radiance relative to a uniform disc of the same irradiance at
+// cos_angle from its centre: (1 - u (1 - mu)) / (1 - u / 3), mu = cos of the
+// angle on the solar surface = sqrt(1 - (theta / alpha)^2), with
+// (theta / alpha)^2 = (1 - cos theta) / (1 - cos alpha) (small angles).
+ATMOS_HD inline double SunLimbFactor(double cos_angle, double cos_radius, double u) {
+    const double x2 = Clamp((1.0 - cos_angle) / (1.0 - cos_radius), 0.0, 1.0);
+    return (1.0 - u * (1.0 - Sqrt(1.0 - x2))) / (1.0 - u / 3.0);
+}
 
 PixelSetup MakePixelSetup(const RenderRequest& request, const AtmosphereParameters& atmosphere);
 
 template <typename Evaluator>
 ATMOS_HD inline Rgb ShadePixel(const Evaluator& evaluator, const PixelSetup& s, int x, int y) {
     const Vec3d dir = s.camera.RayDirection(x, y, s.width, s.height);
+    // No ray (outside a fisheye's circle): black.
+    if (dir.x == 0.0 && dir.y == 0.0 && dir.z == 0.0) return Rgb(0.0f);
     const uint64_t key =
         static_cast<uint64_t>(y) * static_cast<uint64_t>(s.width) + static_cast<uint64_t>(x);
     const RayResult r =
@@ -62,7 +74,14 @@ ATMOS_HD inline Rgb ShadePixel(const Evaluator& evaluator, const PixelSetup& s, 
     if (s.transmittance) return r.transmittance;
     Rgb radiance = (r.sky + r.ground) * s.irradiance;
     if (s.sun_disc && !r.hits_ground && Dot(dir, s.sun_direction) >= s.cos_sun_radius) {
-        radiance += s.irradiance * r.transmittance * s.sun_disc_scale;
+        if (s.limb_darkening == 0.0) {
+            radiance += s.irradiance * r.transmittance * s.sun_disc_scale;
+        } else {
+            const double f =
+                SunLimbFactor(Dot(dir, s.sun_direction), s.cos_sun_radius, s.limb_darkening);
+            radiance += s.irradiance * r.transmittance *
+                        static_cast<float>(static_cast<double>(s.sun_disc_scale) * f);
+        }
     }
     return radiance;  // RenderImage's output guard follows (GuardOutput)
 }
@@ -92,11 +111,22 @@ ATMOS_HD inline SampleAnswer SampleOne(const Evaluator& evaluator, double bottom
     const Vec3d camera(0.0, 0.0, bottom_radius + q.altitude_m);
     const Vec3d dir(sin_v, 0.0, q.mu);
     const Vec3d sun(sin_s * cos(az), sin_s * sin(az), q.mu_s);
-    const RayResult r = EvaluateRay(evaluator, camera, dir, sun, false, key);
+    const bool ground = q.ground != 0;
+    const RayResult r = EvaluateRay(evaluator, camera, dir, sun, ground, key);
     SampleAnswer a;
-    a.radiance = r.sky;
+    a.radiance = ground ? r.sky + r.ground : r.sky;
     a.transmittance = r.hits_ground ? Rgb(0.0f) : r.transmittance;
     return a;  // SampleAll's output guard follows (GuardOutput)
+}
+
+// The view and sun directions of a sample query (SampleOne's frame: the view
+// in the x-z plane, the sun at azimuth_deg from it).
+ATMOS_HD inline void SampleDirections(const SampleQuery& q, Vec3d* dir, Vec3d* sun) {
+    const double sin_v = SafeSqrt(1.0 - q.mu * q.mu);
+    const double sin_s = SafeSqrt(1.0 - q.mu_s * q.mu_s);
+    const double az = Radians(q.azimuth_deg);
+    *dir = Vec3d(sin_v, 0.0, q.mu);
+    *sun = Vec3d(sin_s * cos(az), sin_s * sin(az), q.mu_s);
 }
 
 // The output guard (issue 18 item 3), the last step of every render and
