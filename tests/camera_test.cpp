@@ -17,6 +17,7 @@
 #include "atmos/error.h"
 #include "atmos/image.h"
 #include "atmos/model.h"
+#include "atmos/sun_position.h"
 #include "atmos/view.h"
 #include "harness/irradiance.h"
 
@@ -485,9 +486,11 @@ TEST(Camera, SpecsAreCheckedWithTheKeyAndRange) {
     EXPECT_NE(message([] { ParseSunSpec("elevation=91"); }).find("[-90, 90]"), std::string::npos);
     EXPECT_NE(message([] { ParseSunSpec("azimuth=10"); }).find("needs elevation"),
               std::string::npos);
+    EXPECT_NE(message([] { ParseSunSpec("latitude=1,elevation=3"); }).find("needs time="),
+              std::string::npos);
     EXPECT_NE(message([] {
-                  ParseSunSpec("time=2024-06-21T12:00Z,latitude=1,longitude=2");
-              }).find("solar-position"),
+                  ParseSunSpec("time=2024-06-21T12:00Z,latitude=95,longitude=2");
+              }).find("latitude"),
               std::string::npos);
     EXPECT_EQ(message([] { CheckCameraSpec(ParseCameraSpec("projection=fisheye,fov=190"), 5, 7); }),
               "no error");
@@ -543,3 +546,22 @@ TEST(Camera, CliRefusesBadCamerasAndWritesNothing) {
 }
 
 }  // namespace
+
+// --sun time=...,latitude=...,longitude=... is the direction of the sun's
+// position (NREL SPA, atmos/sun_position.h) at that instant and place, in the
+// frame of the camera (+x east, +y north, +z up); a UTC offset is honoured.
+TEST(Camera, SunFromADateAndPlaceIsTheSolarPosition) {
+    const std::string spec = "time=2024-06-21T14:00:00+02:00,latitude=52.52,longitude=13.405";
+    const SunPosition p = SunFromTimeSpec(spec);
+    const Vec3d d = ParseSunSpec(spec);
+    const double e = p.elevation_deg * kPi / 180.0, a = p.azimuth_deg * kPi / 180.0;
+    EXPECT_NEAR(d.x, std::cos(e) * std::sin(a), 1e-12);  // east
+    EXPECT_NEAR(d.y, std::cos(e) * std::cos(a), 1e-12);  // north
+    EXPECT_NEAR(d.z, std::sin(e), 1e-12);
+    // Berlin, two hours after solar noon's UTC 11:00 or so: high in the south-west.
+    EXPECT_GT(p.elevation_deg, 50.0);
+    EXPECT_GT(p.azimuth_deg, 180.0);
+    const Vec3d same = ParseSunSpec("time=2024-06-21T12:00:00Z,latitude=52.52,longitude=13.405");
+    EXPECT_NEAR(same.x, d.x, 1e-12);
+    EXPECT_NEAR(same.z, d.z, 1e-12);
+}

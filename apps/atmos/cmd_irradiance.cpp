@@ -73,7 +73,9 @@ Command AddIrradianceCommand(CLI::App* root) {
         "quantity,r,g,b; bruneton also its irradiance table)");
     AddCommonOptions(c.app, common.get());
     AddBackendOption(c.app, &common->backend);
-    c.app->add_option("--sun", io->sun, "elevation=DEG[,azimuth=DEG] (as render --sun)");
+    c.app->add_option("--sun", io->sun,
+                      "elevation=DEG[,azimuth=DEG] or time=ISO-8601,latitude=DEG,longitude=DEG (as "
+                      "render --sun)");
     c.app->add_option("--camera", io->camera, "altitude=M: the plane's height above the ground");
     c.run = [common, io] { return CmdIrradiance(*common, *io); };
     return c;

@@ -250,7 +250,8 @@ Command AddRenderCommand(CLI::App* root) {
                        "(docs/views.md); needs --sun");
     render->add_option("--sun", ro->sun,
                        "the sun for --camera: elevation=DEG[,azimuth=DEG] (azimuth clockwise from "
-                       "north, default 0); radiance is then per unit solar irradiance times the "
+                       "north, default 0) or time=ISO-8601,latitude=DEG,longitude=DEG (NREL SPA; "
+                       "docs/sun.md); radiance is then per unit solar irradiance times the "
                        "atmosphere's solar_irradiance");
     render->add_option("--size,-s", ro->size, "image size WIDTHxHEIGHT")->capture_default_str();
     render->add_option("--quantity", ro->quantity, "radiance or transmittance")

@@ -7,6 +7,7 @@
 
 #include "atmos/error.h"
 #include "atmos/number.h"
+#include "atmos/sun_position.h"
 #include "atmos/view.h"
 
 namespace atmos {
@@ -208,10 +209,17 @@ Camera MakeCameraFromSpec(const CameraSpec& spec, const AtmosphereParameters& at
 
 Vec3d ParseSunSpec(const std::string& text) {
     constexpr const char* kFlag = "--sun";
-    constexpr const char* kForm = "elevation=DEG[,azimuth=DEG]";
+    constexpr const char* kForm =
+        "elevation=DEG[,azimuth=DEG] or time=ISO-8601,latitude=DEG,longitude=DEG";
+    // The date-and-place form: NREL's solar position (atmos/sun_position.h),
+    // which checks its own keys (time, latitude, longitude, height, pressure,
+    // temperature, delta-t) and names them in its errors.
+    if (text.rfind("time=", 0) == 0 || text.find(",time=") != std::string::npos) {
+        const SunPosition p = SunFromTimeSpec(text);
+        return DirectionFromAzimuthElevation(p.azimuth_deg, p.elevation_deg);
+    }
     bool has_elevation = false;
     double elevation = 0.0, azimuth = 0.0;
-    std::string date_key;
     for (const auto& [key, value] : SplitKeyValues(text, kFlag, kForm)) {
         if (key == "elevation") {
             elevation = ParseValue(value, kFlag, key, "degrees in [-90, 90]");
@@ -220,19 +228,12 @@ Vec3d ParseSunSpec(const std::string& text) {
         } else if (key == "azimuth") {
             azimuth = ParseValue(value, kFlag, key, "degrees clockwise from north in [-360, 360]");
             CheckRange(azimuth, -360.0, 360.0, false, false, kFlag, "azimuth", " degrees");
-        } else if (key == "time" || key == "latitude" || key == "longitude") {
-            date_key = key;  // the date-and-place form (issue 31 item 2)
+        } else if (key == "latitude" || key == "longitude") {
+            Fail(kFlag, ": ", key, "= needs time= (expected ", kForm, ")");
         } else {
             Fail(kFlag, ": unknown key '", key,
                  "' (keys: elevation, azimuth; or time, latitude, longitude)");
         }
-    }
-    if (!date_key.empty()) {
-        // The place where the solar-position form plugs in: time, latitude and
-        // longitude give (elevation, azimuth) and the same direction follows.
-        Fail(kFlag, " ", date_key,
-             "=: the time-and-place form needs the solar-position module, which this build "
-             "does not have yet; give elevation=DEG,azimuth=DEG");
     }
     if (!has_elevation) Fail(kFlag, " needs elevation=DEG (expected ", kForm, ")");
     return DirectionFromAzimuthElevation(azimuth, elevation);
