@@ -2,13 +2,9 @@
 // engines (EXR, raw float32/float16, JSON) with the GLSL that reads them; and
 // `atmos viewer`: those, for the models with shaders (bruneton, hillaire,
 // atmosphere-plus), in a WebGL2 page.
-#include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
-#include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -17,6 +13,7 @@
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "embedded_assets.h"
+#include "io/bake_files.h"
 #include "io/engine_shaders.h"
 #include "io/output_path.h"
 #include "io/rgba_tables.h"
@@ -27,26 +24,6 @@ namespace atmos::cli {
 namespace {
 
 namespace fs = std::filesystem;
-
-// shaders/FILE.glsl of a model that declares one (ModelCapabilities::shader),
-// or "" for one that does not.
-std::string ShaderAsset(const std::string& model) {
-    const std::string& file = GetModelInfo(model).capabilities.shader;
-    return file.empty() ? "" : "shaders/" + file + ".glsl";
-}
-
-// The viewer's default list: every model with a shader, in registry order.
-std::vector<std::string> ShaderModels() {
-    std::vector<std::string> names;
-    for (const ModelInfo& info : ListModels()) {
-        if (!info.capabilities.shader.empty()) names.push_back(info.name);
-    }
-    return names;
-}
-
-// The math and geometry every model's shader uses (GLSL has no #include: a
-// program concatenates the constants, this, and the model's file).
-constexpr const char* kCommonShader = "shaders/common.glsl";
 
 void WriteText(const fs::path& path, const std::string& text) {
     WriteFileAtomically(path.string(), text);
@@ -77,30 +54,6 @@ std::string BakeInto(const CommonOptions& common, const std::string& dir) {
     return spec.name;
 }
 
-// The page's view of one baked model: MODEL/model.js (its JSON, constants and
-// functions: common.glsl then the model's shader)
-// and MODEL/tables_f32.js, MODEL/tables_f16.js (the raw blobs in base64):
-// scripts, so that the page works from file:// where fetch() is refused.
-void WriteViewerData(const fs::path& dir, const std::string& name) {
-    const std::string json = ReadWholeFile(dir / (name + ".json"));
-    const std::string functions =
-        ReadWholeFile(dir / kCommonShader) + ReadWholeFile(dir / ShaderAsset(name));
-    std::string file = name;
-    for (char& c : file) {
-        if (c == '-') c = '_';
-    }
-    const std::string constants = ReadWholeFile(dir / "shaders" / (file + "_constants.glsl"));
-    WriteText(dir / "model.js", "atmosViewerData.models[" + JsStringLiteral(name) + "] = {bake: " +
-                                    json + ", constants: " + JsStringLiteral(constants) +
-                                    ", functions: " + JsStringLiteral(functions) + "};\n");
-    for (const char* format : {"f32", "f16"}) {
-        const std::string blob = ReadWholeFile(dir / (std::string("tables.") + format));
-        WriteText(dir / (std::string("tables_") + format + ".js"),
-                  "atmosViewerData.tables[" + JsStringLiteral(name + "/" + format) + "] = \"" +
-                      Base64Encode(blob) + "\";\n");
-    }
-}
-
 // A command that bakes into an output directory: the common options and
 // -o/--output (`bake` and `viewer`).
 Command AddOutputCommand(CLI::App* root, const char* name, const char* description,
@@ -112,40 +65,6 @@ Command AddOutputCommand(CLI::App* root, const char* name, const char* descripti
     AddCommonOptions(c.app, common);
     c.app->add_option("-o,--output", *output, "output directory")->required();
     return c;
-}
-
-// The model spec of the bake in `dir` (--load without --model): the JSON a
-// model's Bake writes names the model ("model") and every option ("options").
-std::string BakedModelSpec(const std::string& dir) {
-    std::vector<fs::path> jsons;
-    std::error_code ec;
-    for (const auto& e : fs::directory_iterator(dir, ec)) {
-        if (e.path().extension() == ".json") jsons.push_back(e.path());
-    }
-    std::sort(jsons.begin(), jsons.end());
-    for (const fs::path& path : jsons) {
-        std::ifstream in(path);
-        nlohmann::json j;
-        try {
-            in >> j;
-        } catch (const std::exception&) {
-            continue;
-        }
-        if (!j.is_object() || !j.contains("model") || !j["model"].is_string()) continue;
-        const std::string name = j["model"].get<std::string>();
-        bool known = false;
-        for (const ModelInfo& info : ListModels()) known = known || info.name == name;
-        if (!known) continue;
-        std::string spec = name;
-        if (j.contains("options") && j["options"].is_object()) {
-            for (const auto& [option, value] : j["options"].items()) {
-                spec += ":" + option + "=" +
-                        (value.is_string() ? value.get<std::string>() : value.dump());
-            }
-        }
-        return spec;
-    }
-    Fail("--load ", dir, ": no bake here (a JSON naming its \"model\", written by atmos bake)");
 }
 
 }  // namespace

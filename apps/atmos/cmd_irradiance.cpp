@@ -43,13 +43,7 @@ int CmdIrradiance(const CommonOptions& common, const IrradianceOptions& io) {
     const double elevation = std::asin(Clamp(sun.z, -1.0, 1.0)) * (180.0 / kPi);
     const HorizontalIrradiance e =
         ComputeHorizontalIrradiance(*model, atmosphere, camera.altitude_m, elevation);
-    std::printf("quantity,r,g,b\n");
-    auto row = [](const char* name, const Vec3d& v) {
-        std::printf("%s,%.9g,%.9g,%.9g\n", name, v.x, v.y, v.z);
-    };
-    row("direct", e.direct);
-    row("diffuse", e.diffuse);
-    if (e.has_table) row("diffuse_table", e.diffuse_table);
+    std::fputs(HorizontalIrradianceCsv(e).c_str(), stdout);
     if (!common.quiet) {
         std::fprintf(stderr,
                      "%s: diffuse by %d x %d nodes (mu x azimuth; %d x %d gave %.9g,%.9g,%.9g); "

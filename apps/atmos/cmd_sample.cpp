@@ -1,20 +1,14 @@
 // atmos CLI: `atmos sample`.
-#include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <memory>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "atmos/atmosphere.h"
 #include "atmos/error.h"
 #include "atmos/image.h"
 #include "atmos/model.h"
-#include "atmos/number.h"
 #include "atmos/spectral.h"
 #include "atmos/view.h"
 #include "base/library_progress.h"
@@ -22,186 +16,14 @@
 #include "cli_common.h"
 #include "cli_monte_carlo.h"
 #include "harness/gallery.h"
-#include "io/image_formats.h"
 #include "io/output_path.h"
+#include "io/sample_io.h"
 #include "render/progressive.h"
 #include "sample_spectral.h"
 
 namespace atmos::cli {
 
 namespace {
-
-constexpr const char* kQueryHeader = "altitude_m,mu,mu_s,azimuth_deg";
-
-// Parses one CSV field as a finite number.
-double ParseField(std::string_view text, int line, const char* column) {
-    double v = 0.0;
-    const NumberError e = ParseNumber(text, &v);  // atmos/number.h: the one parser
-    if (e != NumberError::kNone)
-        Fail("line ", line, ": ", column, " '", std::string(text), "' ", NumberErrorText(e));
-    return v;
-}
-
-std::string_view Trim(std::string_view s) {
-    const size_t b = s.find_first_not_of(" \t");
-    if (b == std::string_view::npos) return {};
-    return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
-
-// The range checks of a query (`where`: "line N" or "row N").
-void CheckQuery(const SampleQuery& q, const char* where, int index) {
-    if (q.altitude_m < 0.0) Fail(where, " ", index, ": altitude_m must be >= 0");
-    if (q.mu < -1.0 || q.mu > 1.0) Fail(where, " ", index, ": mu must be in [-1, 1]");
-    if (q.mu_s < -1.0 || q.mu_s > 1.0) Fail(where, " ", index, ": mu_s must be in [-1, 1]");
-}
-
-// The queries of a CSV text: the header line, then one query per line (blank
-// lines skipped; fields trimmed of spaces and tabs; a trailing comma ends the
-// line).
-std::vector<SampleQuery> ParseQueriesCsv(std::string_view text) {
-    std::vector<SampleQuery> queries;
-    int line_number = 0;
-    bool header = false;
-    static const char* const kColumns[4] = {"altitude_m", "mu", "mu_s", "azimuth_deg"};
-    while (!text.empty()) {
-        const size_t eol = text.find('\n');
-        std::string_view line = text.substr(0, eol);
-        text = eol == std::string_view::npos ? std::string_view() : text.substr(eol + 1);
-        ++line_number;
-        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-        if (line.find_first_not_of(" \t") == std::string_view::npos) continue;
-        if (!header) {
-            std::string compact;
-            for (char c : line) {
-                if (c != ' ' && c != '\t') compact += c;
-            }
-            if (compact != kQueryHeader) {
-                Fail("line ", line_number, ": expected the header '", kQueryHeader, "', got '",
-                     std::string(line), "'");
-            }
-            header = true;
-            continue;
-        }
-        std::string_view fields[4];
-        size_t count = 0;
-        std::string_view rest = line;
-        for (;;) {
-            const size_t comma = rest.find(',');
-            if (count < 4) fields[count] = Trim(rest.substr(0, comma));
-            ++count;
-            if (comma == std::string_view::npos) break;
-            rest = rest.substr(comma + 1);
-            if (rest.empty()) break;  // a trailing comma adds no field
-        }
-        if (count != 4) {
-            Fail("line ", line_number, ": expected 4 comma-separated numbers, got ", count,
-                 " fields");
-        }
-        SampleQuery q;
-        double* values[4] = {&q.altitude_m, &q.mu, &q.mu_s, &q.azimuth_deg};
-        for (int i = 0; i < 4; ++i) *values[i] = ParseField(fields[i], line_number, kColumns[i]);
-        CheckQuery(q, "line", line_number);
-        queries.push_back(q);
-    }
-    if (!header) Fail("no input: expected the header '", kQueryHeader, "'");
-    return queries;
-}
-
-std::string ReadAll(std::FILE* f) {
-    std::string text;
-    char buffer[1 << 16];
-    size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, n);
-    return text;
-}
-
-bool IsNpyPath(const std::string& path) {
-    return path.size() >= 4 && path.compare(path.size() - 4, 4, ".npy") == 0;
-}
-
-// The queries of a .npy file of shape (N, 4) (columns as the CSV header), or
-// of a CSV file, or of stdin ("" or "-").
-std::vector<SampleQuery> ReadQueries(const std::string& input) {
-    if (input.empty() || input == "-") return ParseQueriesCsv(ReadAll(stdin));
-    if (!IsNpyPath(input)) {
-        std::FILE* f = std::fopen(input.c_str(), "rb");
-        if (f == nullptr) Fail("cannot read '", input, "': ", std::strerror(errno));
-        const std::string text = ReadAll(f);
-        std::fclose(f);
-        return ParseQueriesCsv(text);
-    }
-    const detail::NpyArray a = detail::ReadNpyArray(input);
-    if (a.shape.size() != 2 || a.shape[1] != 4) {
-        Fail("'", input, "': expected an array of shape (N, 4) (columns ", kQueryHeader,
-             "), got shape ", detail::NpyShapeString(a.shape));
-    }
-    std::vector<SampleQuery> queries(a.values.size() / 4);
-    for (size_t i = 0; i < queries.size(); ++i) {
-        const double* v = &a.values[4 * i];
-        for (int c = 0; c < 4; ++c) {
-            if (!std::isfinite(v[c])) Fail("row ", i, ": a value is not a finite number");
-        }
-        queries[i] = SampleQuery{v[0], v[1], v[2], v[3]};
-        CheckQuery(queries[i], "row", static_cast<int>(i));
-    }
-    return queries;
-}
-
-// Appends `value` as printf's "%.{precision}g" would (std::to_chars with a
-// precision is specified to match it) and `sep`.
-void AppendNumber(std::string* out, size_t* used, double value, int precision, char sep) {
-    char* first = out->data() + *used;
-    const std::to_chars_result r = std::to_chars(first, out->data() + out->size(), value,
-                                                 std::chars_format::general, precision);
-    *r.ptr = sep;
-    *used = static_cast<size_t>(r.ptr + 1 - out->data());
-}
-
-// The answers as CSV (the queries echoed, then L and T), one buffer.
-std::string FormatAnswersCsv(const std::vector<SampleQuery>& queries,
-                             const std::vector<SampleAnswer>& answers) {
-    static const char kHeader[] = "altitude_m,mu,mu_s,azimuth_deg,L_r,L_g,L_b,T_r,T_g,T_b\n";
-    // At most 24 characters per "%.17g" number and 16 per "%.9g" one.
-    constexpr size_t kMaxRow = 4 * 25 + 6 * 17;
-    std::string out(sizeof kHeader - 1 + queries.size() * kMaxRow, '\0');
-    std::memcpy(out.data(), kHeader, sizeof kHeader - 1);
-    size_t used = sizeof kHeader - 1;
-    for (size_t i = 0; i < queries.size(); ++i) {
-        const SampleQuery& q = queries[i];
-        const SampleAnswer& a = answers[i];
-        AppendNumber(&out, &used, q.altitude_m, 17, ',');
-        AppendNumber(&out, &used, q.mu, 17, ',');
-        AppendNumber(&out, &used, q.mu_s, 17, ',');
-        AppendNumber(&out, &used, q.azimuth_deg, 17, ',');
-        const float v[6] = {a.radiance.x,      a.radiance.y,      a.radiance.z,
-                            a.transmittance.x, a.transmittance.y, a.transmittance.z};
-        for (int c = 0; c < 6; ++c) AppendNumber(&out, &used, v[c], 9, c == 5 ? '\n' : ',');
-    }
-    out.resize(used);
-    return out;
-}
-
-void WriteAnswers(const std::string& output, const std::vector<SampleQuery>& queries,
-                  const std::vector<SampleAnswer>& answers) {
-    if (!output.empty() && output != "-" && IsNpyPath(output)) {
-        std::vector<float> values(answers.size() * 6);
-        for (size_t i = 0; i < answers.size(); ++i) {
-            const SampleAnswer& a = answers[i];
-            const float v[6] = {a.radiance.x,      a.radiance.y,      a.radiance.z,
-                                a.transmittance.x, a.transmittance.y, a.transmittance.z};
-            std::memcpy(&values[6 * i], v, sizeof v);
-        }
-        detail::WriteNpyArray(output, {answers.size(), 6}, values.data());
-        return;
-    }
-    const std::string text = FormatAnswersCsv(queries, answers);
-    if (!output.empty() && output != "-") {
-        WriteFileAtomically(output, text);  // a temporary file and one rename
-        return;
-    }
-    const bool ok = std::fwrite(text.data(), 1, text.size(), stdout) == text.size();
-    if (!ok || std::fflush(stdout) != 0) Fail("cannot write the answers to stdout");
-}
 
 struct SampleIo {
     std::string input, output;

@@ -1,6 +1,8 @@
 // atmos: horizontal irradiance by quadrature of a model's sky (harness/irradiance.h).
 #include "harness/irradiance.h"
 
+#include <cstdio>
+
 #include <cmath>
 #include <vector>
 
@@ -108,6 +110,19 @@ HorizontalIrradiance ComputeHorizontalIrradiance(const Model& model,
         out.diffuse_table = Vec3d(table) * e_sun;
     }
     return out;
+}
+
+std::string HorizontalIrradianceCsv(const HorizontalIrradiance& e) {
+    std::string csv = "quantity,r,g,b\n";
+    auto row = [&csv](const char* name, const Vec3d& v) {
+        char line[160];
+        std::snprintf(line, sizeof line, "%s,%.9g,%.9g,%.9g\n", name, v.x, v.y, v.z);
+        csv += line;
+    };
+    row("direct", e.direct);
+    row("diffuse", e.diffuse);
+    if (e.has_table) row("diffuse_table", e.diffuse_table);
+    return csv;
 }
 
 }  // namespace atmos

@@ -2,6 +2,8 @@
 // plane (`atmos irradiance`, Python atmos.irradiance; issue 31 item 3).
 #pragma once
 
+#include <string>
+
 #include "atmos/atmosphere.h"
 #include "atmos/math.h"
 #include "atmos/model.h"
@@ -29,5 +31,9 @@ HorizontalIrradiance ComputeHorizontalIrradiance(const Model& model,
                                                  const AtmosphereParameters& atmosphere,
                                                  double altitude_m, double sun_elevation_deg,
                                                  double tolerance = 1e-4);
+
+// The CSV `atmos irradiance` prints: quantity,r,g,b; rows direct, diffuse and,
+// with a table, diffuse_table ("%.9g").
+std::string HorizontalIrradianceCsv(const HorizontalIrradiance& e);
 
 }  // namespace atmos
