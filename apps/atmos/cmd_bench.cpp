@@ -219,12 +219,15 @@ int CmdBench(const BenchOptions& o) {
     TextOutput csv(o.output);  // written at the end, atomically
     csv << "model,view,width,height,quantity,threads,prepare_s,render_median_s,render_min_s,"
            "render_max_s,repeat,megapixels_per_s,paths_per_s,cpu,compiler,backend\n";
-    const std::string stages_path = !o.stages_output.empty()
-                                        ? o.stages_output
+    // Beside the CSV, unless the CSV goes to a stream (/dev/null, stdout, a
+    // FIFO): then only where --stages-output names it.
+    const std::string stages_path = !o.stages_output.empty() ? o.stages_output
+                                    : IsStreamOutput(o.output)
+                                        ? std::string()
                                         : (fs::path(o.output).parent_path() /
                                            (fs::path(o.output).stem().string() + "_stages.csv"))
                                               .string();
-    CheckOutputFile(stages_path);
+    if (!stages_path.empty()) CheckOutputFile(stages_path);
     TextOutput stages_csv(stages_path);
     stages_csv << "model,view,stage,items,backend,runs,kernel_median_ms,total_median_ms,bytes_up,"
                   "bytes_down\n";
@@ -321,11 +324,11 @@ int CmdBench(const BenchOptions& o) {
         }
     }
     csv.Commit();
-    stages_csv.Commit();
+    if (!stages_path.empty()) stages_csv.Commit();
     std::printf("%s: %d threads, %s, %s; %dx%d, median of %d after %d warm-up%s; wrote %s, %s\n",
                 BackendName(backend), threads, cpu.c_str(), compiler.c_str(), width, height, repeat,
                 warmup, on_device ? " (kernel time, CUDA events)" : "", o.output.c_str(),
-                stages_path.c_str());
+                stages_path.empty() ? "no stages CSV" : stages_path.c_str());
     return 0;
 }
 

@@ -22,6 +22,7 @@
 #include "cli_common.h"
 #include "cli_monte_carlo.h"
 #include "harness/gallery.h"
+#include "io/bounded_read.h"
 #include "io/image_formats.h"
 #include "io/output_path.h"
 #include "render/progressive.h"
@@ -107,14 +108,6 @@ std::vector<SampleQuery> ParseQueriesCsv(std::string_view text) {
     return queries;
 }
 
-std::string ReadAll(std::FILE* f) {
-    std::string text;
-    char buffer[1 << 16];
-    size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, n);
-    return text;
-}
-
 bool IsNpyPath(const std::string& path) {
     return path.size() >= 4 && path.compare(path.size() - 4, 4, ".npy") == 0;
 }
@@ -122,13 +115,13 @@ bool IsNpyPath(const std::string& path) {
 // The queries of a .npy file of shape (N, 4) (columns as the CSV header), or
 // of a CSV file, or of stdin ("" or "-").
 std::vector<SampleQuery> ReadQueries(const std::string& input) {
-    if (input.empty() || input == "-") return ParseQueriesCsv(ReadAll(stdin));
+    // Bounded in size and line length as they are read (io/bounded_read.h).
+    if (input.empty() || input == "-") {
+        return ParseQueriesCsv(
+            ReadBounded(stdin, "the queries on stdin", kMaxQueryInputBytes, kMaxCsvLineBytes));
+    }
     if (!IsNpyPath(input)) {
-        std::FILE* f = std::fopen(input.c_str(), "rb");
-        if (f == nullptr) Fail("cannot read '", input, "': ", std::strerror(errno));
-        const std::string text = ReadAll(f);
-        std::fclose(f);
-        return ParseQueriesCsv(text);
+        return ParseQueriesCsv(ReadFileBounded(input, kMaxQueryInputBytes, kMaxCsvLineBytes));
     }
     const detail::NpyArray a = detail::ReadNpyArray(input);
     if (a.shape.size() != 2 || a.shape[1] != 4) {
@@ -191,7 +184,9 @@ void WriteAnswers(const std::string& output, const std::vector<SampleQuery>& que
                                 a.transmittance.x, a.transmittance.y, a.transmittance.z};
             std::memcpy(&values[6 * i], v, sizeof v);
         }
-        detail::WriteNpyArray(output, {answers.size(), 6}, values.data());
+        WriteThroughTemporary(output, [&](const std::string& temporary) {
+            detail::WriteNpyArray(temporary, {answers.size(), 6}, values.data());
+        });
         return;
     }
     const std::string text = FormatAnswersCsv(queries, answers);
@@ -209,6 +204,7 @@ struct SampleIo {
 
 int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const SampleIo& io,
               const SpectralFlags& spectral) {
+    if (!io.output.empty() && io.output != "-") CheckOutputFile(io.output);  // before the work
     ThreadLimit limit(common.threads);
     const BackendScope backend(ParseBackend(common.backend));
     if (!spectral.wavelengths.empty()) {

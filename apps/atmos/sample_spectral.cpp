@@ -44,7 +44,9 @@ int SampleSpectralCsv(const CommonOptions& common, const MonteCarloSettings& mon
                 row[n + static_cast<size_t>(k)] = static_cast<float>(kMaxLuminousEfficacy * xyz[k]);
             }
         }
-        detail::WriteNpyArray(output, {queries.size(), n + 3}, array.data());
+        WriteThroughTemporary(output, [&](const std::string& temporary) {
+            detail::WriteNpyArray(temporary, {queries.size(), n + 3}, array.data());
+        });
         return 0;
     }
     // The CSV in memory, then to stdout or through a temporary file and one

@@ -324,3 +324,24 @@ def test_memory_does_not_grow_over_1000_calls():
     # 1000 calls allocate 1000 x (24 KB of answers + 12 KB image): a leak of any
     # of them would grow by >= 12 MB.
     assert grown < 4 * 1024 * 1024, f"RSS grew by {grown / 1e6:.1f} MB over 1000 calls"
+
+
+def test_the_output_guard_warns_or_raises_like_the_cli():
+    """Issue 39 item 4: values the guard replaced are counted and reported (a
+    RuntimeWarning; ValueError under strict=True, the CLI's --strict), never
+    zeroed silently."""
+    import warnings
+    from atmos import _atmos
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        atmos._guarded(lambda: _atmos._guard_nan_for_test(3), False)
+    assert len(caught) == 1 and issubclass(caught[0].category, RuntimeWarning)
+    assert "3 output value(s)" in str(caught[0].message)
+    with pytest.raises(ValueError, match="2 output value"):
+        atmos._guarded(lambda: _atmos._guard_nan_for_test(2), True)
+    # A clean call says nothing.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = atmos.Model("flat").prepare("earth")
+        m.sample(0.0, 0.5, 0.5, strict=True)
+        m.render(size=(8, 4), strict=True)

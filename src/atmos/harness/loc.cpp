@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "atmos/error.h"
+#include "io/bounded_read.h"
 
 namespace fs = std::filesystem;
 
@@ -86,11 +87,8 @@ int CountSignificantLines(const std::string& text) {
 }
 
 int CountSignificantLinesInFile(const std::string& path) {
-    std::ifstream f(path);
-    if (!f) Fail("cannot read '", path, "'");
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return CountSignificantLines(ss.str());
+    // Bounded (io/bounded_read.h): `loc --file /dev/zero` grew without end.
+    return CountSignificantLines(ReadFileBounded(path, kMaxSourceFileBytes));
 }
 
 std::vector<std::string> ModelSourceFiles(const std::string& source_dir, const std::string& name) {
