@@ -4,8 +4,9 @@
 # Usage: scripts/test.sh [--sanitize | --integration]
 #   --sanitize: ASan + UBSan build in build-asan/, without the Python module (an
 #     instrumented extension cannot load into python3);
-#   --integration: only the tests labelled `integration` (a real renderer uses
-#     atmos's output: Blender, installed here with apt-get when missing).
+#   --integration: only the heavy checks: the tests labelled `integration` (a
+#     real renderer uses atmos's output: Blender, installed here with apt-get when
+#     missing) and `fuzz` (the bad-input sweep, the fault and interrupt suites).
 # The default run leaves out the labels `slow` and `integration`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,7 +22,7 @@ if [ "${1:-}" = "--integration" ]; then
     fi
     # Reconfigure so that CMake finds Blender and adds the tests.
     cmake "$build_dir" >/dev/null
-    ctest --test-dir "$build_dir" --output-on-failure -L integration
+    ctest --test-dir "$build_dir" --output-on-failure -L 'integration|fuzz'
     exit
 fi
 scripts/setup.sh "$@"

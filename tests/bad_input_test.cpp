@@ -86,6 +86,16 @@ TEST(BadInput, EveryCommandGivesOneLineAndExitTwo) {
     typed.replace(typed.find("\"mie_phase_g\": 0.8"), 18, "\"mie_phase_g\": \"high\"");
     std::ofstream(dir / "type.json") << typed;
     fs::create_directories(dir / "adir.exr");
+    // Issue 38 item 6: a PNG whose header claims 20000x20000 (33 bytes; it
+    // cost 5.9 GB and 55 s), a query line of 5000 characters.
+    {
+        static const char kHugePng[] =
+            "\x89\x50\x4e\x47\x0d\x0a\x1a\x0a\x00\x00\x00\x0d\x49\x48\x44\x52\x00\x00"
+            "\x4e\x20\x00\x00\x4e\x20\x08\x02\x00\x00\x00\x6c\x12\xd1\x6e";
+        std::ofstream(dir / "huge.png", std::ios::binary).write(kHugePng, sizeof kHugePng - 1);
+    }
+    std::error_code ignored;
+    fs::create_symlink("/dev/zero", dir / "zero.bin", ignored);
     const std::string out = " -o " + d + "/x.exr";
     const std::vector<Case> cases = {
         // Sizes.
@@ -123,6 +133,14 @@ TEST(BadInput, EveryCommandGivesOneLineAndExitTwo) {
         {"fit --model neural --horizon-fraction -0.5 -o " + d + "/w.json", "--horizon-fraction"},
         {"fit --model neural --loss-epsilon -1 -o " + d + "/w.json", "--loss-epsilon"},
         {"fit --model neural --loss-epsilon nan -o " + d + "/w.json", "--loss-epsilon"},
+        // Issue 39 item 3: training settings (inf trained NaN weights, exit 0).
+        {"fit --model neural --learning-rate inf -o " + d + "/w.json", "--learning-rate"},
+        {"fit --model neural --learning-rate nan -o " + d + "/w.json", "--learning-rate"},
+        {"fit --model neural --learning-rate 5 -o " + d + "/w.json", "--learning-rate"},
+        {"fit --model neural --final-learning-rate inf -o " + d + "/w.json",
+         "--final-learning-rate"},
+        {"fit --model neural --scattering-samples 2000000000 -o " + d + "/w.json",
+         "--scattering-samples"},
         {"render --quantity colour --size 8x4" + out, "unknown quantity"},
         // Models and their options: NaN, infinity, hexadecimal, out of range, wrong type.
         {"render --model nope --size 8x4" + out, "unknown model 'nope'"},
@@ -180,6 +198,14 @@ TEST(BadInput, EveryCommandGivesOneLineAndExitTwo) {
         {"compare --ppd -1 -o " + d + "/cmp", "--ppd"},
         {"fit --model naive -o " + d + "/w.json", "only --model neural"},
         {"bench --repeat 0 --size 8x4", "--repeat"},
+        // Issue 38 item 6: bounded inputs, each one line before the memory grows.
+        {"loc --file /dev/zero", "larger than the 64 MiB"},
+        {"sample -i /dev/zero", "line 1 is longer than 4096 characters"},
+        {"sample", "line 2 is longer than 4096 characters",
+         std::string(kHeader) + std::string(5000, '1') + ",0,0,0\n"},
+        {"flip " + d + "/huge.png " + d + "/huge.png", "claims 20000x20000"},
+        {"render --model reference --size 8x4 --spp 2 --resume --checkpoint " + d + "/zero" + out,
+         "not a regular file"},
     };
     const auto start = std::chrono::steady_clock::now();
     for (const Case& c : cases) {

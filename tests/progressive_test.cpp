@@ -3,6 +3,7 @@
 // uniform random numbers, passes weighted by their counts, checkpoint and
 // resume, the variance, and one clear error for models that are not Monte Carlo.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cstdlib>
 #include <cstring>
@@ -299,6 +300,93 @@ TEST(Progressive, ADamagedCheckpointIsOneClearError) {
     EXPECT_EQ(std::memcmp(resumed.data(), full.data(), full.size() * sizeof(float)), 0);
     // The temporary file is gone once committed.
     EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+}
+
+// Issue 39 item 6: a hand-edited checkpoint with a recomputed checksum whose
+// sums are out of range (negative, the even half above the whole, a sum of
+// squares too small for its sum and count, non-zero sums where no sample was
+// taken) or whose fingerprint is another render's is refused; a directory or
+// a FIFO in its place is one clear error, never a block.
+TEST(Progressive, ACheckpointsSumsAreRangeChecked) {
+    const CoinModel model(true);
+    const std::filesystem::path dir = TestDir("progressive_ranges");
+    RenderRequest request = CoinRequest(6, 3);
+    request.checkpoint = (dir / "coin").string();
+    Image image;
+    model.Render(request, &image);
+    const std::string path = request.checkpoint + ".bin";
+    std::string good;
+    {
+        std::ifstream f(path, std::ios::binary);
+        good.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+    }
+    uint64_t header_size = 0;
+    std::memcpy(&header_size, good.data() + 8, 8);
+    const size_t sums = 16 + header_size, n = 5 * 3 * 3;
+    auto resum = [](std::string bytes) {
+        uint64_t h = 14695981039346656037ull;
+        for (size_t i = 0; i + 8 < bytes.size(); ++i) {
+            h ^= static_cast<unsigned char>(bytes[i]);
+            h *= 1099511628211ull;
+        }
+        std::memcpy(&bytes[bytes.size() - 8], &h, 8);
+        return bytes;
+    };
+    auto with_float = [&](size_t index, float value) {
+        std::string bytes = good;
+        std::memcpy(&bytes[sums + 4 * index], &value, 4);
+        return resum(bytes);
+    };
+    request.monte_carlo.spp = 12;
+    request.resume = true;
+    auto expect_refused = [&](const std::string& bytes, const char* why) {
+        std::filesystem::remove_all(path);
+        std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+        try {
+            model.Render(request, &image);
+            ADD_FAILURE() << "resumed from a checkpoint with " << why;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+        }
+    };
+    float sum0 = 0.0f, sq0 = 0.0f;
+    std::memcpy(&sum0, &good[sums], 4);
+    std::memcpy(&sq0, &good[sums + 4 * n], 4);
+    ASSERT_GT(sum0, 0.0f);
+    expect_refused(with_float(0, -sum0), "negative");
+    expect_refused(with_float(n, -sq0), "negative");
+    // sum^2 <= samples x sum_sq: a sum of squares of a tenth breaks it.
+    expect_refused(with_float(n, sq0 * 0.1f), "disagree with the sample counts");
+    // A sum 100 times larger, its square sum as it was.
+    expect_refused(with_float(0, sum0 * 100.0f), "disagree with the sample counts");
+    // The fingerprint: another seed is another render.
+    std::string seed = good;
+    const size_t at = seed.find("\"seed\":11");
+    ASSERT_NE(at, std::string::npos);
+    seed[at + 8] = '2';
+    expect_refused(resum(seed), "different render");
+    EXPECT_NE(good.find("\"estimator_version\""), std::string::npos);
+    // A directory, a FIFO: one clear error at once.
+    std::filesystem::remove(path);
+    std::filesystem::create_directories(path);
+    try {
+        model.Render(request, &image);
+        ADD_FAILURE() << "resumed from a directory";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+    }
+    std::filesystem::remove(path);
+    ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
+    try {
+        model.Render(request, &image);
+        ADD_FAILURE() << "resumed from a FIFO";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+    }
+    std::filesystem::remove(path);
+    // The intact checkpoint still resumes.
+    std::ofstream(path, std::ios::binary) << good;
+    EXPECT_NO_THROW(model.Render(request, &image));
 }
 
 }  // namespace

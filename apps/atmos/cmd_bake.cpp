@@ -37,16 +37,20 @@ std::string BakeInto(const CommonOptions& common, const std::string& dir) {
     if (!model->CanBake()) Fail("model ", common.model, " has no precomputed tables to bake");
     ThreadLimit limit(common.threads);
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
-    CheckOutputDirectory(dir);  // before the precomputation (io/output_path.h)
+    StagedDirectory::Check(dir);  // before the precomputation (io/output_path.h)
     const double seconds = PrepareModel(common, atmosphere, model.get());
-    fs::create_directories(dir);
-    model->Bake(dir);
+    // One transaction (io/output_path.h): a failed or interrupted bake leaves
+    // the previous one intact, never a mix of two.
+    StagedDirectory staged(dir);
+    const fs::path into(staged.path());
+    model->Bake(into.string());
     if (const char* shader = FindAsset(ShaderAsset(spec.name))) {
-        fs::create_directories(fs::path(dir) / "shaders");
-        WriteText(fs::path(dir) / ShaderAsset(spec.name), shader);
-        WriteText(fs::path(dir) / kCommonShader, FindAsset(kCommonShader));
-        WriteEngineShaders(dir, spec.name, common.quiet);  // Vulkan, HLSL, Metal
+        fs::create_directories(into / "shaders");
+        WriteText(into / ShaderAsset(spec.name), shader);
+        WriteText(into / kCommonShader, FindAsset(kCommonShader));
+        WriteEngineShaders(into.string(), spec.name, common.quiet);  // Vulkan, HLSL, Metal
     }
+    staged.Commit();
     if (!common.quiet) {
         std::fprintf(stderr, "baked %s (precomputed in %.3f s) into %s\n", common.model.c_str(),
                      seconds, dir.c_str());
@@ -135,20 +139,22 @@ Command AddViewerCommand(CLI::App* root) {
             }
         }
         const fs::path dir(*output);
-        CheckOutputDirectory(dir.string());  // before any precomputation
-        fs::create_directories(dir);
+        StagedDirectory::Check(dir.string());  // before any precomputation
+        StagedDirectory staged(dir.string());  // one transaction, as bake
+        const fs::path into(staged.path());
         std::string list;
         for (const std::string& spec : specs) {
             CommonOptions one = *common;
             one.model = spec;
             const std::string name = ParseModelSpec(spec).name;
-            BakeInto(one, (dir / name).string());
-            WriteViewerData(dir / name, name);
+            BakeInto(one, (into / name).string());
+            WriteViewerData(into / name, name);
             list += (list.empty() ? "" : ", ") + JsStringLiteral(name);
         }
-        WriteText(dir / "index.html", FindAsset("viewer/index.html"));
-        WriteText(dir / "viewer.js", FindAsset("viewer/viewer.js"));
-        WriteText(dir / "models.js", "var atmosViewerModels = [" + list + "];\n");
+        WriteText(into / "index.html", FindAsset("viewer/index.html"));
+        WriteText(into / "viewer.js", FindAsset("viewer/viewer.js"));
+        WriteText(into / "models.js", "var atmosViewerModels = [" + list + "];\n");
+        staged.Commit();
         if (!common->quiet) {
             std::fprintf(stderr, "viewer: open %s\n",
                          (fs::absolute(dir) / "index.html").string().c_str());

@@ -46,15 +46,18 @@ int CmdBench(BenchOptions o) {
     ThreadLimit limit(o.study.threads);
     const BackendScope backend_scope(ParseBackend(o.study.backend));
     const bool spectral = !c.wavelengths.empty();
-    const std::string stages_path = !o.stages_output.empty()
-                                        ? o.stages_output
+    // Beside the CSV, unless the CSV goes to a stream (/dev/null, stdout, a
+    // FIFO): then only where --stages-output names it.
+    const std::string stages_path = !o.stages_output.empty() ? o.stages_output
+                                    : IsStreamOutput(o.output)
+                                        ? std::string()
                                         : (fs::path(o.output).parent_path() /
                                            (fs::path(o.output).stem().string() + "_stages.csv"))
                                               .string();
-    if (fs::path(o.output).has_parent_path())
+    if (fs::path(o.output).has_parent_path() && !IsStreamOutput(o.output))
         fs::create_directories(fs::path(o.output).parent_path());
     CheckOutputFile(o.output);
-    if (!spectral) CheckOutputFile(stages_path);
+    if (!spectral && !stages_path.empty()) CheckOutputFile(stages_path);
     const BenchResult r = RunBench(c, [](const std::string& line) {
         std::fputs(line.c_str(), stdout);
         std::fflush(stdout);
@@ -65,11 +68,11 @@ int CmdBench(BenchOptions o) {
         return 0;
     }
     WriteFileAtomically(o.output, BenchCsv(r));
-    WriteFileAtomically(stages_path, BenchStagesCsv(r));
+    if (!stages_path.empty()) WriteFileAtomically(stages_path, BenchStagesCsv(r));
     std::printf("%s: %d threads, %s, %s; %dx%d, median of %d after %d warm-up%s; wrote %s, %s\n",
                 r.backend.c_str(), r.threads, r.cpu.c_str(), r.compiler.c_str(), c.width, c.height,
                 r.repeat, r.warmup, r.on_device ? " (kernel time, CUDA events)" : "",
-                o.output.c_str(), stages_path.c_str());
+                o.output.c_str(), stages_path.empty() ? "no stages CSV" : stages_path.c_str());
     return 0;
 }
 

@@ -128,6 +128,11 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     } else {
         CheckOutputFile(ro.output);
     }
+    // A named checkpoint's directory exists and is writable (atmos creates none).
+    if (!ro.checkpoint.empty()) CheckCheckpointFile(ro.checkpoint + ".bin");
+    // An image written to a stream (/dev/stdout, a FIFO, /dev/null) has no
+    // files beside it: no default checkpoint, no variance image.
+    const bool stream_output = !all_views && IsStreamOutput(ro.output);
     if (!std::isfinite(ro.exposure) || ro.exposure < 0.0f) {
         Fail("--exposure must be a positive number");
     }
@@ -179,7 +184,8 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
                                  : all_views           ? ro.checkpoint + "-" + view.name
                                                        : ro.checkpoint;
             request.resume = ro.resume;
-            request.variance = &variance;
+            if (!stream_output) request.variance = &variance;
+            if (stream_output && ro.checkpoint.empty()) request.checkpoint.clear();
         }
         Image image;
         const auto start = std::chrono::steady_clock::now();

@@ -1,12 +1,14 @@
 // atmos: the command-line tool (contract in DESIGN.md, "The command line").
 //
 // Every failure prints one line, "atmos: error: ...", on stderr and exits with
-// status 2 (usage and input errors) or 1 (anything else unexpected). Each
+// status 2 (issue 38 item 6: out of memory and unexpected exceptions too). Each
 // subcommand registers itself from its own file (cli_common.h).
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -105,8 +107,15 @@ int main(int argc, char** argv) {
         if (!e.path2().empty()) paths += "' -> '" + e.path2().string();
         std::fprintf(stderr, "atmos: error: '%s': %s\n", paths.c_str(), e.code().message().c_str());
         return 2;
+    } catch (const std::bad_alloc&) {
+        // An input too large for this machine's memory (issue 38 item 6).
+        std::fprintf(stderr,
+                     "atmos: error: out of memory (an input or size too large for this "
+                     "machine)\n");
+        return 2;
     } catch (const std::exception& e) {
-        const std::string what = e.what();
+        std::string what = e.what();
+        std::replace(what.begin(), what.end(), '\n', ' ');  // one line
         // A JSON library exception that escaped a parser: malformed input.
         const std::string json_tag = "[json.exception.";
         if (what.rfind(json_tag, 0) == 0) {
@@ -116,7 +125,10 @@ int main(int argc, char** argv) {
             return 2;
         }
         std::fprintf(stderr, "atmos: error: %s\n", what.c_str());
-        return 1;
+        return 2;
+    } catch (...) {
+        std::fprintf(stderr, "atmos: error: an unexpected failure (not a standard exception)\n");
+        return 2;
     }
     return 0;
 }

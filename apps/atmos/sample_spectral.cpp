@@ -27,8 +27,10 @@ int SampleSpectralCsv(const CommonOptions& common, const MonteCarloSettings& mon
         [&](const AtmosphereParameters& a, Model* model) { PrepareModel(common, a, model); },
         batching);
     if (npy) {
-        detail::WriteNpyArray(output, {queries.size(), nm.size() + 3},
-                              SpectralSampleArray(nm, queries.size(), values).data());
+        const std::vector<float> array = SpectralSampleArray(nm, queries.size(), values);
+        WriteThroughTemporary(output, [&](const std::string& temporary) {
+            detail::WriteNpyArray(temporary, {queries.size(), nm.size() + 3}, array.data());
+        });
         return 0;
     }
     const std::string text = SpectralSampleCsv(nm, queries, values);

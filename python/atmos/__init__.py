@@ -11,6 +11,9 @@ The same library as the `atmos` command line (docs/python.md):
 
 Errors of the library (unknown names, options out of range, invalid
 atmosphere fields, NaN queries) are ValueError with the command line's message.
+Output values a model got NaN, infinite or negative are written as 0 and
+counted, as by the command line: Model.sample and Model.render then warn
+(RuntimeWarning), or raise ValueError with strict=True (the CLI's --strict).
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from __future__ import annotations
 import collections
 import json as _json
 import os as _os
+import warnings as _warnings
 
 import numpy as _np
 
@@ -272,7 +276,7 @@ class Model:
         self._m.bake(_os.fspath(directory))
 
     def sample(self, altitude, mu, mu_s, azimuth=0.0, *, spp=None, seed=None, ground=False,
-               sun_disc=False):
+               sun_disc=False, strict=False):
         """Radiance per unit solar irradiance and transmittance at queries of
         `atmos sample` (camera at altitude metres, view cosine mu, sun cosine
         mu_s, sun azimuth in degrees). The four arguments broadcast as NumPy
@@ -282,8 +286,8 @@ class Model:
         adds the lit ground and sun_disc=True the sun's disc, as a rendered
         pixel shows them (`atmos sample --ground --sun-disc`)."""
         args = [_np.asarray(a, dtype=_np.float64) for a in (altitude, mu, mu_s, azimuth)]
-        return self._m.sample(*args, spp=spp, seed=seed, ground=bool(ground),
-                              sun_disc=bool(sun_disc))
+        return _guarded(lambda: self._m.sample(*args, spp=spp, seed=seed, ground=bool(ground),
+                                               sun_disc=bool(sun_disc)), strict)
 
     def irradiance(self, sun, altitude=0.0):
         """The sun's direct and the sky's diffuse irradiance on a horizontal
@@ -297,7 +301,8 @@ class Model:
 
     def render(self, view="ground-noon", size=(480, 270), *, camera=None, sun=None,
                quantity="radiance", sun_disc=False, spp=None, seed=None, pass_spp=None,
-               checkpoint=None, resume=False, return_variance=False, progress=None):
+               checkpoint=None, resume=False, return_variance=False, progress=None,
+               strict=False):
         """Renders a standard view, or a free `camera` (atmos.Camera) with a
         `sun` (elevation_deg, azimuth_deg): float32 array H x W x 3 (linear,
         as the EXR of `atmos render`; docs/views.md gives the projections).
@@ -317,10 +322,10 @@ class Model:
             camera_text = Camera().spec
         callback, bar = _progress_callback(progress)
         try:
-            return self._m.render(
+            return _guarded(lambda: self._m.render(
                 view, int(width), int(height), quantity, bool(sun_disc), spp, seed, pass_spp,
                 "" if checkpoint is None else _os.fspath(checkpoint), bool(resume),
-                bool(return_variance), callback, camera_text, sun_text)
+                bool(return_variance), callback, camera_text, sun_text), strict)
         finally:
             if bar is not None:
                 bar.close()
@@ -374,6 +379,22 @@ class Camera:
 
     def __repr__(self):
         return "atmos.Camera(%s)" % self.spec
+
+
+def _guarded(call, strict):
+    """Runs call(); when it made the output guard replace values (NaN,
+    infinite or negative, written as 0), warns as the CLI does, or raises
+    ValueError when strict (the CLI's --strict exits 2)."""
+    before = _atmos.output_guard_count()
+    result = call()
+    replaced = _atmos.output_guard_count() - before
+    if replaced > 0:
+        message = (f"atmos: {replaced} output value(s) were NaN, infinite or negative and were "
+                   "written as 0 (a defect: please report it with the call)")
+        if strict:
+            raise ValueError(message)
+        _warnings.warn(message, RuntimeWarning, stacklevel=3)
+    return result
 
 
 def _progress_callback(progress):

@@ -12,6 +12,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -32,6 +33,7 @@
 #include "metrics/flip.h"
 #include "metrics/rmse.h"
 #include "render/progressive.h"
+#include "render/render.h"
 
 namespace py = pybind11;
 
@@ -658,4 +660,12 @@ PYBIND11_MODULE(_atmos, mod) {
         py::arg("pressure"), py::arg("temperature"), py::arg("delta_t"), py::arg("refraction"));
     mod.attr("__version__") = ATMOS_VERSION;  // the CMake project's (python/CMakeLists.txt)
     BindStudies(mod);
+    // The output guard's process-wide count (render/render.h): Model.sample and
+    // Model.render warn or raise when a call added to it (issue 39 item 4).
+    mod.def("output_guard_count", [] { return OutputGuardCount(); });
+    // Tests: guards `nan` NaN values (as a model's defect would), returning the count.
+    mod.def("_guard_nan_for_test", [](int nan) {
+        std::vector<float> values(static_cast<size_t>(std::max(nan, 0)), std::nanf(""));
+        return GuardOutput(values.data(), values.size());
+    });
 }

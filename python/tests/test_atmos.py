@@ -387,3 +387,24 @@ def test_prepare_uses_the_table_cache(tmp_path, monkeypatch):
     b = again.render(view="ground-sunrise", size=(16, 9))
     assert a.tobytes() == b.tobytes()
     assert atmos.Model("hillaire")._m.prepare(atmos.Atmosphere.load("earth")._json, False) is False
+
+
+def test_the_output_guard_warns_or_raises_like_the_cli():
+    """Issue 39 item 4: values the guard replaced are counted and reported (a
+    RuntimeWarning; ValueError under strict=True, the CLI's --strict), never
+    zeroed silently."""
+    import warnings
+    from atmos import _atmos
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        atmos._guarded(lambda: _atmos._guard_nan_for_test(3), False)
+    assert len(caught) == 1 and issubclass(caught[0].category, RuntimeWarning)
+    assert "3 output value(s)" in str(caught[0].message)
+    with pytest.raises(ValueError, match="2 output value"):
+        atmos._guarded(lambda: _atmos._guard_nan_for_test(2), True)
+    # A clean call says nothing.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = atmos.Model("flat").prepare("earth")
+        m.sample(0.0, 0.5, 0.5, strict=True)
+        m.render(size=(8, 4), strict=True)

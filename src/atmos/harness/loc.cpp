@@ -9,6 +9,7 @@
 
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "io/bounded_read.h"
 
 namespace fs = std::filesystem;
 
@@ -87,11 +88,8 @@ int CountSignificantLines(const std::string& text) {
 }
 
 int CountSignificantLinesInFile(const std::string& path) {
-    std::ifstream f(path);
-    if (!f) Fail("cannot read '", path, "'");
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return CountSignificantLines(ss.str());
+    // Bounded (io/bounded_read.h): `loc --file /dev/zero` grew without end.
+    return CountSignificantLines(ReadFileBounded(path, kMaxSourceFileBytes));
 }
 
 namespace {

@@ -10,6 +10,7 @@
 
 #include "atmos/error.h"
 #include "io/image_formats.h"
+#include "io/output_path.h"
 #include "render/progressive.h"
 
 namespace atmos {
@@ -230,9 +231,11 @@ void WriteSpectralExr(const SpectralImage& image, const std::string& path) {
         for (size_t i = 0; i < n; ++i) values[p * (n + 3) + i] = image.values[p * n + i];
         for (size_t k = 0; k < 3; ++k) values[p * (n + 3) + n + k] = rgb.data()[p * 3 + k];
     }
-    detail::WriteMultiChannelExr(
-        path, image.width, image.height, names, values,
-        {{"spectralLayoutVersion", "1.0"}, {"emissiveUnits", "W.m^-2.sr^-1"}});
+    WriteThroughTemporary(path, [&](const std::string& temporary) {
+        detail::WriteMultiChannelExr(
+            temporary, image.width, image.height, names, values,
+            {{"spectralLayoutVersion", "1.0"}, {"emissiveUnits", "W.m^-2.sr^-1"}});
+    });
 }
 
 }  // namespace atmos

@@ -15,21 +15,21 @@
 #include <vector>
 
 #include "atmos/error.h"
+#include "io/bounded_read.h"
 #include "io/image_formats.h"
 
 namespace atmos::detail {
 
 namespace {
 
-constexpr std::int64_t kMaxPixels = std::int64_t{1} << 31;
-
 // Sizes an image for an EXR data window, rejecting absurd dimensions.
 Image AllocateFor(const Imath::Box2i& window, const std::string& path) {
     const std::int64_t width = std::int64_t{window.max.x} - window.min.x + 1;
     const std::int64_t height = std::int64_t{window.max.y} - window.min.y + 1;
-    if (width <= 0 || height <= 0 || width * height > kMaxPixels) {
+    if (width <= 0 || height <= 0) {
         Fail("cannot read '", path, "': invalid EXR data window (", width, "x", height, ")");
     }
+    CheckImageDimensions(width, height, "'" + path + "'");  // before allocating
     return Image(static_cast<int>(width), static_cast<int>(height));
 }
 

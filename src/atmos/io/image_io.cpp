@@ -9,11 +9,9 @@
 
 #include "atmos/error.h"
 #include "atmos/image.h"
+#include "io/bounded_read.h"
 #include "io/image_formats.h"
 #include "io/output_path.h"
-
-#include <fcntl.h>
-#include <unistd.h>
 
 namespace atmos {
 
@@ -89,108 +87,6 @@ void WriteImage(const Image& image, const std::string& path, float exposure) {
     });
 }
 
-void WriteThroughTemporary(const std::string& path,
-                           const std::function<void(const std::string& temporary)>& write) {
-    if (std::filesystem::is_directory(path)) Fail("cannot write '", path, "': it is a directory");
-    const std::filesystem::path target(path);
-    const std::string temporary =
-        (target.parent_path() /
-         ("." + target.filename().string() + ".tmp-" +
-          std::to_string(static_cast<long>(::getpid())) + target.extension().string()))
-            .string();
-    try {
-        write(temporary);
-        std::error_code ec;
-        std::filesystem::rename(temporary, target, ec);
-        if (ec) Fail("cannot write '", path, "': ", ec.message());
-    } catch (const Error& e) {
-        std::error_code ignored;
-        std::filesystem::remove(temporary, ignored);
-        // The writers name the temporary file: name the target instead.
-        std::string message = e.what();
-        for (size_t at = message.find(temporary); at != std::string::npos;
-             at = message.find(temporary, at + path.size())) {
-            message.replace(at, temporary.size(), path);
-        }
-        throw Error(message);
-    } catch (...) {
-        std::error_code ignored;
-        std::filesystem::remove(temporary, ignored);
-        throw;
-    }
-}
-
-void WriteFileAtomically(const std::string& path, const std::string& bytes) {
-    WriteThroughTemporary(path, [&](const std::string& temporary) {
-        FilePtr f(std::fopen(temporary.c_str(), "wb"));
-        if (!f) Fail("cannot write '", temporary, "': ", std::strerror(errno));
-        const bool written = std::fwrite(bytes.data(), 1, bytes.size(), f.get()) == bytes.size() &&
-                             std::fflush(f.get()) == 0;
-        const int err = errno;
-        if (std::fclose(f.release()) != 0 || !written) {
-            Fail("cannot write '", temporary, "': ", std::strerror(written ? errno : err));
-        }
-    });
-}
-
-namespace {
-
-// Creates and removes a probe file in `directory`; the errno text on failure.
-std::string ProbeWritable(const std::filesystem::path& directory) {
-    const std::string probe =
-        (directory / (".atmos-write-probe-" + std::to_string(static_cast<long>(::getpid()))))
-            .string();
-    errno = 0;
-    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd < 0) return std::strerror(errno);
-    ::close(fd);
-    ::unlink(probe.c_str());
-    return "";
-}
-
-}  // namespace
-
-void CheckOutputFile(const std::string& path) {
-    if (path.empty()) Fail("the output path is empty");
-    const std::filesystem::path p(path);
-    std::error_code ec;
-    if (std::filesystem::is_directory(p, ec)) Fail("cannot write '", path, "': it is a directory");
-    const std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : ".";
-    if (!std::filesystem::exists(dir, ec)) {
-        Fail("cannot write '", path, "': the directory '", dir.string(), "' does not exist");
-    }
-    if (!std::filesystem::is_directory(dir, ec)) {
-        Fail("cannot write '", path, "': '", dir.string(), "' is not a directory");
-    }
-    const std::string why = ProbeWritable(dir);
-    if (!why.empty()) Fail("cannot write '", path, "': ", why);
-}
-
-void CheckOutputDirectory(const std::string& path) {
-    if (path.empty()) Fail("the output directory is empty");
-    std::error_code ec;
-    if (std::filesystem::exists(path, ec)) {
-        if (!std::filesystem::is_directory(path, ec)) {
-            Fail("cannot write to directory '", path, "': it exists and is not a directory");
-        }
-        const std::string why = ProbeWritable(path);
-        if (!why.empty()) Fail("cannot write to directory '", path, "': ", why);
-        return;
-    }
-    // Not there yet (the command creates it after its checks): the nearest
-    // existing ancestor must be a writable directory.
-    std::filesystem::path ancestor = std::filesystem::absolute(path, ec).parent_path();
-    while (!ancestor.empty() && !std::filesystem::exists(ancestor, ec)) {
-        if (ancestor == ancestor.parent_path()) break;
-        ancestor = ancestor.parent_path();
-    }
-    if (!std::filesystem::is_directory(ancestor, ec)) {
-        Fail("cannot create directory '", path, "': '", ancestor.string(), "' is not a directory");
-    }
-    const std::string why = ProbeWritable(ancestor);
-    if (!why.empty()) Fail("cannot create directory '", path, "': ", why);
-}
-
 Image ReadImage(const std::string& path) {
     switch (ImageFormatFromPath(path)) {
         case ImageFormat::kExr:
@@ -208,20 +104,9 @@ Image ReadImage(const std::string& path) {
 namespace detail {
 
 std::vector<std::uint8_t> ReadFileBytes(const std::string& path) {
-    errno = 0;
-    FilePtr file(std::fopen(path.c_str(), "rb"));
-    if (!file) Fail("cannot open '", path, "' for reading: ", std::strerror(errno));
-    std::vector<std::uint8_t> bytes;
-    std::uint8_t chunk[1 << 16];
-    for (;;) {
-        const size_t n = std::fread(chunk, 1, sizeof(chunk), file.get());
-        bytes.insert(bytes.end(), chunk, chunk + n);
-        if (n < sizeof(chunk)) break;
-    }
-    if (std::ferror(file.get())) {
-        Fail("cannot read '", path, "': ", errno != 0 ? std::strerror(errno) : "read error");
-    }
-    return bytes;
+    // Bounded (io/bounded_read.h): /dev/zero or an endless FIFO is one error.
+    const std::string text = ReadFileBounded(path, kMaxImageFileBytes);
+    return std::vector<std::uint8_t>(text.begin(), text.end());
 }
 
 void WriteFileBytes(const std::string& path, const std::vector<std::uint8_t>& bytes) {

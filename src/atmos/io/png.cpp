@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "atmos/error.h"
+#include "io/bounded_read.h"
 #include "io/image_formats.h"
 
 namespace atmos::detail {
@@ -162,6 +163,21 @@ Image ReadPng(const std::string& path) {
     if (std::fread(signature, 1, sizeof(signature), file.get()) != sizeof(signature) ||
         png_sig_cmp(signature, 0, sizeof(signature)) != 0) {
         Fail("cannot read PNG '", path, "': not a PNG file (bad signature)");
+    }
+    // The size its header (IHDR, the first chunk) claims, before anything is
+    // read or allocated for it (io/bounded_read.h: a 33-byte file claiming
+    // 20000x20000 cost 6 GB).
+    {
+        png_byte ihdr[16] = {};
+        if (std::fread(ihdr, 1, sizeof ihdr, file.get()) != sizeof ihdr ||
+            std::memcmp(ihdr + 4, "IHDR", 4) != 0) {
+            Fail("cannot read PNG '", path, "': no IHDR chunk first");
+        }
+        CheckImageDimensions(png_get_uint_32(ihdr + 8), png_get_uint_32(ihdr + 12),
+                             "PNG '" + path + "'");
+        if (std::fseek(file.get(), sizeof(signature), SEEK_SET) != 0) {
+            Fail("cannot read PNG '", path, "': ", std::strerror(errno));
+        }
     }
 
     PngPixels pixels;

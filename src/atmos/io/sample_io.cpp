@@ -12,6 +12,7 @@
 
 #include "atmos/error.h"
 #include "atmos/number.h"
+#include "io/bounded_read.h"
 #include "io/image_formats.h"
 #include "io/output_path.h"
 
@@ -97,17 +98,7 @@ std::vector<SampleQuery> ParseQueriesCsv(std::string_view text) {
     return queries;
 }
 
-namespace {
-
-std::string ReadAll(std::FILE* f) {
-    std::string text;
-    char buffer[1 << 16];
-    size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, n);
-    return text;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 bool IsNpyPath(const std::string& path) {
     return path.size() >= 4 && path.compare(path.size() - 4, 4, ".npy") == 0;
@@ -116,13 +107,13 @@ bool IsNpyPath(const std::string& path) {
 // The queries of a .npy file of shape (N, 4) (columns as the CSV header), or
 // of a CSV file, or of stdin ("" or "-").
 std::vector<SampleQuery> ReadQueries(const std::string& input) {
-    if (input.empty() || input == "-") return ParseQueriesCsv(ReadAll(stdin));
+    // Bounded in size and line length as they are read (io/bounded_read.h).
+    if (input.empty() || input == "-") {
+        return ParseQueriesCsv(
+            ReadBounded(stdin, "the queries on stdin", kMaxQueryInputBytes, kMaxCsvLineBytes));
+    }
     if (!IsNpyPath(input)) {
-        std::FILE* f = std::fopen(input.c_str(), "rb");
-        if (f == nullptr) Fail("cannot read '", input, "': ", std::strerror(errno));
-        const std::string text = ReadAll(f);
-        std::fclose(f);
-        return ParseQueriesCsv(text);
+        return ParseQueriesCsv(ReadFileBounded(input, kMaxQueryInputBytes, kMaxCsvLineBytes));
     }
     const detail::NpyArray a = detail::ReadNpyArray(input);
     if (a.shape.size() != 2 || a.shape[1] != 4) {
@@ -189,7 +180,9 @@ void WriteAnswers(const std::string& output, const std::vector<SampleQuery>& que
                                 a.transmittance.x, a.transmittance.y, a.transmittance.z};
             std::memcpy(&values[6 * i], v, sizeof v);
         }
-        detail::WriteNpyArray(output, {answers.size(), 6}, values.data());
+        WriteThroughTemporary(output, [&](const std::string& temporary) {
+            detail::WriteNpyArray(temporary, {answers.size(), 6}, values.data());
+        });
         return;
     }
     const std::string text = FormatAnswersCsv(queries, answers);

@@ -9,6 +9,7 @@
 #include "atmos/error.h"
 #include "base/parallel.h"
 #include "io/image_formats.h"
+#include "io/output_path.h"
 
 namespace atmos {
 
@@ -563,7 +564,9 @@ void WriteColorMappedPng(const std::vector<float>& map, int width, int height,
     }
     std::vector<std::uint8_t> bytes(map.size() * 3);
     for (size_t i = 0; i < map.size(); ++i) FlipMagma(map[i], &bytes[3 * i]);
-    detail::WritePngBytes(bytes, width, height, path);
+    WriteThroughTemporary(path, [&](const std::string& temporary) {
+        detail::WritePngBytes(bytes, width, height, temporary);
+    });
 }
 
 }  // namespace atmos

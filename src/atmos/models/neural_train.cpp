@@ -266,8 +266,19 @@ NeuralFitChoices CheckNeuralFitOptions(const NeuralFitOptions& o) {
     if (o.transmittance_steps < 1 || o.scattering_steps < 1 || o.batch < 1) {
         Fail("fit: steps and batch must be >= 1");
     }
-    if (!(o.learning_rate > 0.0 && o.final_learning_rate > 0.0)) {
-        Fail("fit: learning rates must be > 0");
+    // Bounded sizes (memory: one sample is a query and an answer) and finite
+    // step sizes: `--learning-rate inf` trained weights that were all NaN.
+    if (o.transmittance_samples > 10000000 || o.scattering_samples > 10000000) {
+        Fail("fit: --transmittance-samples and --scattering-samples must be in [10, 10000000]");
+    }
+    if (o.transmittance_steps > 100000000 || o.scattering_steps > 100000000 || o.batch > 1000000) {
+        Fail("fit: iterations must be in [1, 100000000] and --batch in [1, 1000000]");
+    }
+    if (!(o.learning_rate > 0.0 && o.learning_rate <= 1.0)) {
+        Fail("fit: --learning-rate must be in (0, 1], got ", o.learning_rate);
+    }
+    if (!(o.final_learning_rate > 0.0 && o.final_learning_rate <= 1.0)) {
+        Fail("fit: --final-learning-rate must be in (0, 1], got ", o.final_learning_rate);
     }
     if (!(o.holdout >= 0.0 && o.holdout < 0.9)) Fail("fit: holdout must be in [0, 0.9)");
     const bool large = o.network == "large";
@@ -450,6 +461,14 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     tj["scattering_holdout_rms_log"] = r.scattering.holdout_rms_log;
     tj["scattering_holdout_rel_mean"] = r.scattering.holdout_rel_mean;
     w.training_json = tj.dump();
+    // Weights that are not finite (a diverged fit) are refused here, as
+    // `render` would refuse them, so nothing unusable is written.
+    try {
+        NeuralWeightsFromJson(NeuralWeightsToJson(w), "fitted");
+    } catch (const Error& e) {
+        Fail("fit: the fit diverged: its weights are not finite numbers (", e.what(),
+             "); nothing written: lower --learning-rate or --final-learning-rate");
+    }
     if (report) *report = r;
     return w;
 }

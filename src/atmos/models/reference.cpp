@@ -347,6 +347,8 @@ void ReferenceModel::RenderPass(const RenderRequest& request, const MonteCarloPa
     std::shared_ptr<const Table> order1;  // alive for the pass, whatever later requests do
     if (request.quantity != Quantity::kTransmittance &&
         e.estimator == ReferenceEstimator::kHybrid) {
+        // Its bar shows where the pass's does (RenderImageInterruptible).
+        const LibraryProgressScope bar(progress != nullptr && progress->active());
         order1 = Order1Table(setup, e);
         e.order1_table = order1->view();
         e.order1_cached = true;
@@ -392,7 +394,9 @@ std::shared_ptr<const Table> ReferenceModel::Order1Table(const PixelSetup& setup
         unit.first_row = 0;  // the whole image, whatever band the pass renders
         Image image;
         image.Resize(setup.width, setup.height);
-        RenderImage(first, unit, image.View(), nullptr);
+        // In bands that act on a stop signal and show progress (issue 39 item 1).
+        RenderImageInterruptible(first, unit, image.View(), LibraryProgressEnabled(),
+                                 "reference: order 1");
         auto table = std::make_shared<Table>(setup.width, setup.height, 1, 3);
         for (int y = 0; y < setup.height; ++y) {
             for (int x = 0; x < setup.width; ++x) {

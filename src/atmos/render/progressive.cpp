@@ -19,7 +19,9 @@
 #include <string>
 
 #include "atmos/error.h"
+#include "base/interrupt.h"
 #include "base/progress.h"
+#include "io/output_path.h"
 #include "metrics/flip.h"
 #include "render/render.h"
 
@@ -54,6 +56,9 @@ void CheckSettings(const MonteCarloSettings& mc) {
 nlohmann::json CheckpointKey(const Model& model, const RenderRequest& request, int64_t pass_spp) {
     nlohmann::json key;
     key["format"] = "atmos-checkpoint-2";
+    // The driver's estimator (passes weighted by their counts, batch-means
+    // variance): bump when it changes what a pass adds to the sums.
+    key["estimator_version"] = 1;
     key["model"] = model.Info().name;
     key["model_key"] = nlohmann::json::parse(model.PassKey());
     key["view"] = request.view.name;
@@ -89,14 +94,13 @@ nlohmann::json CheckpointKey(const Model& model, const RenderRequest& request, i
     return key;
 }
 
-// A checkpoint is one file, STEM.bin, committed atomically: written to
-// STEM.bin.tmp, fsync'ed, renamed over STEM.bin, its directory fsync'ed. A kill
-// at any point leaves the previous checkpoint (or none) intact. Layout (host
-// byte order): the 8 bytes "atmosck2", the header's length (uint64), the
-// header (JSON: the render's key, width, height, passes_done, samples_done,
-// and for a checkpoint inside a pass rows_done and pass_samples: that pass's
-// rows [0, rows_done) of pass_samples samples are in the sums too), the sums
-// and the sums of squares (float32, width x height x 3 each; a noise-targeted
+// A checkpoint is one file, STEM.bin, committed atomically: written to a
+// temporary created exclusively beside it (.STEM.bin.tmp-RANDOM), fsync'ed, renamed over STEM.bin,
+// its directory fsync'ed. A kill at any point leaves the previous checkpoint (or none) intact.
+// Layout (host byte order): the 8 bytes "atmosck2", the header's length (uint64), the header (JSON:
+// the render's key, width, height, passes_done, samples_done, and for a checkpoint inside a pass
+// rows_done and pass_samples: that pass's rows [0, rows_done) of pass_samples samples are in the
+// sums too), the sums and the sums of squares (float32, width x height x 3 each; a noise-targeted
 // render also the even passes' sum), and a 64-bit FNV-1a checksum of
 // everything before it.
 constexpr char kCheckpointMagic[8] = {'a', 't', 'm', 'o', 's', 'c', 'k', '2'};
@@ -161,17 +165,29 @@ void WriteCheckpoint(const std::string& path, const nlohmann::json& key,
     const uint64_t checksum = Fnv1a(bytes.data(), bytes.size());
     bytes.append(reinterpret_cast<const char*>(&checksum), sizeof checksum);
 
+    // The checkpoint's directory is the user's (checked before the work:
+    // atmos creates none); the temporary is created exclusively beside it, so
+    // a link planted under a predictable name cannot redirect the write.
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent);
-    const std::string tmp = path + ".tmp";
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) Fail("cannot write checkpoint '", tmp, "': ", std::strerror(errno));
-    WriteAll(fd, bytes, tmp);
+    std::string tmp;
+    const int fd = CreateExclusiveFile(parent.empty() ? "." : parent.string(),
+                                       std::filesystem::path(path).filename().string(), &tmp,
+                                       "checkpoint '" + path + "'");
+    try {
+        WriteAll(fd, bytes, path);
+    } catch (...) {
+        ::unlink(tmp.c_str());
+        throw;
+    }
     if (::fsync(fd) != 0 || ::close(fd) != 0) {
-        Fail("cannot write checkpoint '", tmp, "': ", std::strerror(errno));
+        const int err = errno;
+        ::unlink(tmp.c_str());
+        Fail("cannot write checkpoint '", path, "': ", std::strerror(err));
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        Fail("cannot commit checkpoint '", path, "': ", std::strerror(errno));
+        const int err = errno;
+        ::unlink(tmp.c_str());
+        Fail("cannot commit checkpoint '", path, "': ", std::strerror(err));
     }
     const std::string dir = parent.empty() ? "." : parent.string();
     const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
@@ -189,6 +205,24 @@ CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& ke
         Fail("checkpoint '", path, "' is damaged (", why,
              "); remove it or drop --resume to start over");
     };
+    // Only a regular file (a FIFO would block, a device never end), of at
+    // most the size this render's checkpoint can have: read before anything
+    // is allocated for it.
+    std::error_code ec;
+    const std::filesystem::file_status status = std::filesystem::status(path, ec);
+    if (std::filesystem::is_directory(status)) {
+        Fail("checkpoint '", path, "' is a directory; remove it or give another --checkpoint");
+    }
+    if (!std::filesystem::is_regular_file(status)) {
+        Fail("checkpoint '", path,
+             "' is not a regular file (a FIFO, a device or a socket); remove it or give another "
+             "--checkpoint");
+    }
+    const uintmax_t file_size = std::filesystem::file_size(path, ec);
+    const uintmax_t most =
+        16 + (uintmax_t{1} << 20) + 8 +
+        uintmax_t{3} * static_cast<uintmax_t>(width) * height * 3 * sizeof(float);
+    if (ec || file_size > most) damaged("larger than this render's checkpoint can be");
     std::ifstream f(path, std::ios::binary);
     if (!f) Fail("cannot read checkpoint '", path, "'");
     const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
@@ -254,51 +288,31 @@ CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& ke
     }
     for (size_t i = 0; i < n; ++i) {
         if (!std::isfinite(s.sum.data()[i]) || !std::isfinite(s.sum_sq.data()[i]) ||
-            s.sum_sq.data()[i] < 0.0f || (halves && !std::isfinite(s.sum_even.data()[i]))) {
+            (halves && !std::isfinite(s.sum_even.data()[i]))) {
             damaged("a sum is not finite");
+        }
+    }
+    // The sums are of non-negative pass means v weighted by their sample
+    // counts w: sum = S w v >= 0, sum_sq = S w v^2 >= 0, the even passes' sum
+    // within [0, sum], and (Cauchy-Schwarz) sum^2 <= W sum_sq with W = S w the
+    // pixel's samples (zero sums where W is 0). A little slack for float sums.
+    for (int y = 0; y < height; ++y) {
+        const double samples = static_cast<double>(s.samples_done) +
+                               (y < s.rows_done ? static_cast<double>(s.pass_samples) : 0.0);
+        for (size_t i = static_cast<size_t>(y) * width * 3;
+             i < static_cast<size_t>(y + 1) * width * 3; ++i) {
+            const double sum = s.sum.data()[i], sq = s.sum_sq.data()[i];
+            const double even = halves ? static_cast<double>(s.sum_even.data()[i]) : 0.0;
+            if (sum < 0.0 || sq < 0.0 || even < 0.0) damaged("a sum is negative");
+            if (even > sum * (1.0 + 1e-5) + 1e-30) damaged("its halves' sums disagree");
+            if (samples == 0.0 ? (sum != 0.0 || sq != 0.0)
+                               : sum * sum > samples * sq * (1.0 + 1e-4) + 1e-30) {
+                damaged("its sums and sums of squares disagree with the sample counts");
+            }
         }
     }
     return s;
 }
-
-}  // namespace
-
-namespace {
-
-// SIGINT / SIGTERM during a checkpointed render (issue 18 item 10): the
-// handler only records the signal and restores the default action (a second
-// signal ends the process at once); the driver finishes the pass, writes the
-// checkpoint and stops with one line saying how to resume.
-volatile sig_atomic_t g_stop_signal = 0;
-
-extern "C" void RecordStopSignal(int signal_number) { g_stop_signal = signal_number; }
-
-class StopSignalScope {
-  public:
-    explicit StopSignalScope(bool active) : active_(active) {
-        if (!active_) return;
-        g_stop_signal = 0;
-        struct sigaction action {};
-        action.sa_handler = RecordStopSignal;
-        sigemptyset(&action.sa_mask);
-        action.sa_flags = SA_RESETHAND;
-        sigaction(SIGINT, &action, &old_int_);
-        sigaction(SIGTERM, &action, &old_term_);
-    }
-    ~StopSignalScope() {
-        if (!active_) return;
-        sigaction(SIGINT, &old_int_, nullptr);
-        sigaction(SIGTERM, &old_term_, nullptr);
-    }
-    StopSignalScope(const StopSignalScope&) = delete;
-    StopSignalScope& operator=(const StopSignalScope&) = delete;
-    int Received() const { return active_ ? static_cast<int>(g_stop_signal) : 0; }
-
-  private:
-    bool active_;
-    struct sigaction old_int_ {};
-    struct sigaction old_term_ {};
-};
 
 }  // namespace
 
@@ -365,6 +379,11 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     const std::string path = stem + ".bin";
     const nlohmann::json key =
         stem.empty() ? nlohmann::json() : CheckpointKey(model, request, pass_spp);
+    // One run per checkpoint: a second run on it fails here, before any pass.
+    const FileLock lock(stem.empty() ? std::string() : path);
+    // Its place holds a checkpoint or nothing: a directory, a FIFO or a device
+    // there is refused before the work, never replaced.
+    if (!stem.empty() && !request.resume) CheckCheckpointFile(path);
     CheckpointState state;
     state.sum.Resize(request.width, request.height);
     state.sum_sq.Resize(request.width, request.height);
@@ -486,10 +505,9 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
                 last_save = Clock::now();
             }
             if (signal_number != 0) {
-                Fail("interrupted by ", signal_number == SIGINT ? "SIGINT" : "SIGTERM", " in pass ",
-                     p + 1, " of ", passes, " (", samples_done, " of ", spp,
-                     " samples per pixel and ", row, " of ", height,
-                     " rows of the next pass done); the checkpoint '", path,
+                Fail("interrupted by ", StopSignalName(signal_number), " in pass ", p + 1, " of ",
+                     passes, " (", samples_done, " of ", spp, " samples per pixel and ", row,
+                     " of ", height, " rows of the next pass done); the checkpoint '", path,
                      "' holds them: the same command with --resume continues");
             }
         }
@@ -517,8 +535,8 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
             }
         }
         if (signal_number != 0 && p + 1 < passes && !reached) {
-            Fail("interrupted by ", signal_number == SIGINT ? "SIGINT" : "SIGTERM", " after pass ",
-                 passes_done, " of ", passes, " (", samples_done, " of ", spp,
+            Fail("interrupted by ", StopSignalName(signal_number), " after pass ", passes_done,
+                 " of ", passes, " (", samples_done, " of ", spp,
                  " samples per pixel); the checkpoint '", path,
                  "' holds them: the same command with --resume continues");
         }

@@ -1,9 +1,12 @@
 #include "render/render.h"
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 
 #include "atmos/error.h"
+#include "base/interrupt.h"
 
 namespace atmos {
 
@@ -72,6 +75,35 @@ void ResetOutputGuardCount(int64_t value) { g_guarded.store(value); }
 void FailNoDeviceKernels(const char* evaluator) {
     Fail("device backend: evaluator ", evaluator,
          " has no device kernels (its model is not in src/atmos/models/model_list.h)");
+}
+
+void ForEachInterruptibleBand(
+    const PixelSetup& setup, ImageView out, const char* step,
+    const std::function<void(const PixelSetup&, ImageView)>& render_band) {
+    using Clock = std::chrono::steady_clock;
+    constexpr double kBandSeconds = 0.25;
+    const int width = std::max(setup.width, 1);
+    int rows = std::clamp(16384 / width, 1, std::max(out.height, 1));
+    for (int row = 0; row < out.height;) {
+        // Between bands (a step of one band runs as before, whatever the timing).
+        if (const int signal_number = row > 0 ? StopSignalReceived() : 0) {
+            Fail("interrupted by ", StopSignalName(signal_number), " during ", step, " (", row,
+                 " of ", out.height,
+                 " rows done; a checkpoint holds only whole passes' samples and bands: the same "
+                 "command, with --resume where one was written, starts again)");
+        }
+        const int n = std::min(rows, out.height - row);
+        PixelSetup band_setup = setup;
+        band_setup.first_row = setup.first_row + row;
+        const ImageView band{out.data + static_cast<size_t>(row) * out.width * 3, out.width, n};
+        const auto start = Clock::now();
+        render_band(band_setup, band);
+        const double per_row = std::chrono::duration<double>(Clock::now() - start).count() / n;
+        rows = per_row > 0.0 ? static_cast<int>(std::clamp(kBandSeconds / per_row, 1.0,
+                                                           static_cast<double>(out.height)))
+                             : out.height;
+        row += n;
+    }
 }
 
 void FailBadBand(int width, int height, int first_row, int band_width, int band_rows) {

@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include <cstdint>
+#include <functional>
 #include <typeinfo>
 #include <vector>
 
@@ -231,6 +232,26 @@ void RenderImage(const Evaluator& evaluator, const PixelSetup& setup, ImageView 
                  bool show_progress) {
     Progress progress("render", static_cast<int64_t>(setup.width) * setup.height, show_progress);
     RenderImage(evaluator, setup, out, &progress);
+}
+
+// Renders the whole image `out` (setup.first_row 0) by calling `render_band`
+// on bands of its rows (the first of 16384 pixels, then of about a quarter of
+// a second each at the rate measured), and between two bands stops with one
+// atmos::Error naming `step` when a stop signal came (base/interrupt.h): long
+// whole-image steps act on SIGINT within about a second at any size (issue 39
+// item 1).
+void ForEachInterruptibleBand(const PixelSetup& setup, ImageView out, const char* step,
+                              const std::function<void(const PixelSetup&, ImageView)>& render_band);
+
+// RenderImage in such bands, with a progress bar of its own labelled `step`.
+// Each pixel depends on its coordinates only: the image is RenderImage's.
+template <typename Evaluator>
+void RenderImageInterruptible(const Evaluator& evaluator, const PixelSetup& setup, ImageView out,
+                              bool show_progress, const char* step) {
+    Progress progress(step, static_cast<int64_t>(setup.width) * out.height, show_progress);
+    ForEachInterruptibleBand(setup, out, step, [&](const PixelSetup& band_setup, ImageView band) {
+        RenderImage(evaluator, band_setup, band, &progress);
+    });
 }
 
 // Answers every query through RunStage("sample", ...), advancing `progress`
