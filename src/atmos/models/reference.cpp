@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -120,6 +121,35 @@ Table BuildSunColumnTable(const AtmosphereParameters& atm, int mu_size, int r_si
         }
     });
     return table;
+}
+
+bool SunTableResolves(const SunTransmittanceTable& table, const AtmosphereParameters& atm,
+                      double* worst) {
+    constexpr int kN = 64;
+    const double delta = atm.top_radius - atm.bottom_radius;
+    std::vector<double> err(kN, 0.0);
+    std::vector<char> ok(kN, 1);
+    ParallelFor(kN, 1, [&](int64_t i) {
+        const double x = static_cast<double>(i) / (kN - 1);
+        const double r = atm.bottom_radius + delta * x * x * x * x * (1.0 - 1e-9);
+        for (int j = 0; j < kN; ++j) {
+            const double y = (j + 0.5) / (kN / 2) - 1.0;
+            const double mu = y < 0.0 ? -y * y : y * y;
+            if (RayIntersectsGround(r, mu, atm.bottom_radius)) continue;
+            const Vec3d p(0.0, 0.0, r);
+            const Vec3d dir(std::sqrt(std::max(1.0 - mu * mu, 0.0)), 0.0, mu);
+            const Vec3d exact = Exp(-AdaptiveOpticalDepth(
+                atm, p, dir, DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius)));
+            const Vec3d t = table.Lookup(r, mu);
+            for (int c = 0; c < 3; ++c) {
+                const double d = std::abs(t[c] - exact[c]);
+                err[i] = std::max(err[i], d);
+                if (d > 1e-3 || (exact[c] > 0.01 && d > 1e-2 * exact[c])) ok[i] = 0;
+            }
+        }
+    });
+    if (worst) *worst = *std::max_element(err.begin(), err.end());
+    return std::all_of(ok.begin(), ok.end(), [](char v) { return v != 0; });
 }
 
 BrunetonLut BuildReferenceGuideLut(const AtmosphereParameters& atm, Table* transmittance,
@@ -293,6 +323,7 @@ const ReferenceEvaluator& ReferenceModel::evaluator() const {
     if (!sun_table_ready_ && evaluator_.estimator == ReferenceEstimator::kHybrid) {
         sun_table_ = SharedSunColumnTable(evaluator_.atm);
         evaluator_.sun_table.Set(sun_table_->view(), evaluator_.atm);
+        evaluator_.sun_table.direct = !SunTableResolves(evaluator_.sun_table, evaluator_.atm);
         if (evaluator_.guide_candidates > 0) {
             evaluator_.guide_lut =
                 BuildReferenceGuideLut(evaluator_.atm, &guide_transmittance_, &guide_scattering_);

@@ -84,7 +84,7 @@ namespace atmos {
 // quadrature (the sun column table, the order-1 table), a new bias or its
 // removal. A change of variance only (sampling, majorants, MIS) keeps it; an
 // option's default change is caught by the fingerprint's resolved options.
-inline constexpr int kReferenceEstimatorVersion = 1;
+inline constexpr int kReferenceEstimatorVersion = 2;
 
 constexpr int kMaxReferenceShells = 64;
 
@@ -121,6 +121,108 @@ enum class ReferenceEstimator : int {
     kThesis = 2,
 };
 
+// The optical depth of the segment origin + t dir, t in [0, length], by
+// adaptive Simpson (issue 32): the segment is cut at its lowest point, each
+// piece mapped by t = a + (b - a) u^2 from its low end (dense where the air
+// is), 8 panels per piece to start, each halved (at most 1024 times in all,
+// 30 deep) until Simpson agrees with its halves within 15 (1e-7 + 1e-5 dtau)
+// and with the trapezoid in t on the same points within 1e-6 + dtau / 2 (a
+// density concentrated near u = 0, where dt/du vanishes, cannot slip between
+// the points). Converged on any geometry: a thin slab on a giant planet, an
+// 8 km scale height in a 1e9 m shell, an optically thick layer. The
+// reference's fallback where its sun table does not resolve an atmosphere,
+// and its view transmittance output (`tracking`).
+struct AdaptivePoint {
+    double t, jac;
+    Vec3d sigma;  // extinction
+};
+
+ATMOS_HD inline Vec3d AdaptiveOpticalDepth(const AtmosphereParameters& atm, const Vec3d& origin,
+                                           const Vec3d& dir, double length) {
+    if (!(length > 0.0)) return Vec3d(0.0);
+    double cuts[3] = {0.0, length, length};
+    int nc = 2;
+    const double t_low = -Dot(origin, dir);
+    if (t_low > 1e-9 * length && t_low < (1.0 - 1e-9) * length) {
+        cuts[1] = t_low;
+        nc = 3;
+    }
+    Vec3d tau;
+    int budget = 1024;
+    for (int k = 0; k + 1 < nc; ++k) {
+        const double a = cuts[k], b = cuts[k + 1], span = b - a;
+        const bool low_at_a = Length(origin + dir * a) <= Length(origin + dir * b);
+        auto eval = [&](double u) {
+            AdaptivePoint q;
+            if (low_at_a) {
+                q.t = a + span * u * u;
+                q.jac = 2.0 * span * u;
+            } else {
+                q.t = b - span * (1.0 - u) * (1.0 - u);
+                q.jac = 2.0 * span * (1.0 - u);
+            }
+            q.sigma =
+                Extinction(atm, GetDensities(atm, Length(origin + dir * q.t) - atm.bottom_radius));
+            return q;
+        };
+        struct Panel {
+            double u0, u1;
+            AdaptivePoint p0, p2, p4;
+        };
+        constexpr int kPanels = 8;
+        constexpr int kStack = 32;
+        for (int p = 0; p < kPanels; ++p) {
+            Panel stack[kStack];
+            int top = 0;
+            Panel& first = stack[top++];
+            first.u0 = static_cast<double>(p) / kPanels;
+            first.u1 = static_cast<double>(p + 1) / kPanels;
+            first.p0 = eval(first.u0);
+            first.p2 = eval(0.5 * (first.u0 + first.u1));
+            first.p4 = eval(first.u1);
+            while (top > 0) {
+                const Panel e = stack[--top];
+                const double w = e.u1 - e.u0;
+                const AdaptivePoint p1 = eval(e.u0 + 0.25 * w);
+                const AdaptivePoint p3 = eval(e.u0 + 0.75 * w);
+                const Vec3d g0 = e.p0.sigma * e.p0.jac, g1 = p1.sigma * p1.jac;
+                const Vec3d g2 = e.p2.sigma * e.p2.jac, g3 = p3.sigma * p3.jac;
+                const Vec3d g4 = e.p4.sigma * e.p4.jac;
+                const Vec3d s1 = (g0 + g2 * 4.0 + g4) * (w / 6.0);
+                const Vec3d s2 = (g0 + g1 * 4.0 + g2 * 2.0 + g3 * 4.0 + g4) * (w / 12.0);
+                const double dtau = MaxComponent(s2);
+                const double err = MaxComponent(Max(s2 - s1, s1 - s2));
+                const Vec3d trap = ((e.p0.sigma + p1.sigma) * (p1.t - e.p0.t) +
+                                    (p1.sigma + e.p2.sigma) * (e.p2.t - p1.t) +
+                                    (e.p2.sigma + p3.sigma) * (p3.t - e.p2.t) +
+                                    (p3.sigma + e.p4.sigma) * (e.p4.t - p3.t)) *
+                                   0.5;
+                const double gross = MaxComponent(Max(trap - s2, s2 - trap));
+                const bool split = top + 2 <= kStack && budget > 0 &&
+                                   (err > 15.0 * (1e-7 + 1e-5 * dtau) || gross > 1e-6 + 0.5 * dtau);
+                if (split) {
+                    --budget;
+                    Panel& right = stack[top++];
+                    right.u0 = e.u0 + 0.5 * w;
+                    right.u1 = e.u1;
+                    right.p0 = e.p2;
+                    right.p2 = p3;
+                    right.p4 = e.p4;
+                    Panel& left = stack[top++];
+                    left.u0 = e.u0;
+                    left.u1 = e.u0 + 0.5 * w;
+                    left.p0 = e.p0;
+                    left.p2 = p1;
+                    left.p4 = e.p2;
+                    continue;
+                }
+                tau += s2;
+            }
+        }
+    }
+    return tau;
+}
+
 // The sun's transmittance from a point (r, mu_s) to space: 0 when the ray meets
 // the ground (exact geometry), else exp(-tau) with tau = beta_R c_R + beta_M,ext
 // c_M + beta_A c_A, the column densities c (m, density x length) bilinear in a
@@ -135,6 +237,11 @@ struct SunTransmittanceTable {
     TableView columns;  // 3 channels: Rayleigh, Mie, absorption column to the top boundary
     double bottom = 0.0, top = 0.0;
     Vec3d rayleigh, mie_extinction, absorption;  // the coefficients (1/m) per channel
+    // true: the table does not resolve this atmosphere (SunTableResolves
+    // failed: e.g. an 8 km scale height on a planet of radius 1e9 m, whose
+    // seed 004 parameterisation puts the whole atmosphere in one texel): the
+    // evaluator integrates each sun ray by AdaptiveOpticalDepth instead.
+    bool direct = false;
 
     // The table `columns` (BuildSunColumnTable) of the atmosphere `atm`.
     void Set(const TableView& table, const AtmosphereParameters& atm) {
@@ -144,6 +251,7 @@ struct SunTransmittanceTable {
         rayleigh = atm.rayleigh_scattering;
         mie_extinction = atm.mie_extinction;
         absorption = atm.absorption_extinction;
+        direct = false;
     }
 
     ATMOS_HD Vec3d Lookup(double r, double mu) const {
@@ -179,11 +287,30 @@ std::shared_ptr<const Table> SharedSunColumnTable(const AtmosphereParameters& at
 // `intervals` (even) intervals (what the table gives at its texels).
 Vec3d SunOpticalDepthQuadrature(const AtmosphereParameters& atm, double r, double mu,
                                 int intervals);
+// Whether `table` (the sun table of `atm`) gives the sun's transmittance
+// within 1e-3 absolute and 1e-2 relative (where T > 0.01) of
+// AdaptiveOpticalDepth at 64 x 64 points (altitudes dense near the ground,
+// directions dense near the horizon); *worst gets the largest |dT|.
+bool SunTableResolves(const SunTransmittanceTable& table, const AtmosphereParameters& atm,
+                      double* worst = nullptr);
 
 // The view ray's per-pixel table of the hybrid estimator: about this many
 // intervals in all, at most kHybridMaxNodes nodes.
 constexpr int kHybridViewIntervals = 96;
 constexpr int kHybridMaxNodes = 128;
+// The table's capacity: adaptive refinement (BuildViewTable) adds nodes where
+// the initial ones do not resolve the ray, up to this many in all, halving a
+// panel at most kMaxViewLevels times.
+constexpr int kHybridNodeCapacity = 256;
+constexpr int kMaxViewLevels = 20;
+// BuildViewTable's acceptance of a panel: Simpson against its halves within
+// 15 (kViewTauAbs + kViewTauRel dtau), the trapezoid within kViewGrossAbs +
+// dtau / 2, at most kViewMaxStep of view or sun optical depth across it (all
+// relaxed by exp(tau0 / 5) where the light is already attenuated by tau0).
+constexpr double kViewTauAbs = 1e-5;
+constexpr double kViewTauRel = 1e-4;
+constexpr double kViewGrossAbs = 1e-4;
+constexpr double kViewMaxStep = 0.5;
 // The most next-event comb points per continuation segment.
 constexpr int kMaxNeeComb = 8;
 // The most candidate directions of the order-2 guide per first vertex.
@@ -645,9 +772,61 @@ struct ReferenceEvaluator {
         Vec3d sun_t;
     };
 
+    // A monotonic piece [a, b] of the view segment: t = a + span u^2 from its
+    // low end (b - span (1 - u)^2 when the low end is b), n initial intervals.
+    struct ViewPiece {
+        double a, b, span;
+        bool low_at_a;
+        int n;
+    };
+    // A Simpson panel waiting to be tested: nodes j0, j0 + 1, j0 + 2 of
+    // n 2^level intervals (its start is the table's last node).
+    struct ViewPanel {
+        int level;
+        int64_t j0;
+        ViewNode mid, end;
+    };
+
+    // The node u = j / denom of a piece (the sun's transmittance only with_sun).
+    ATMOS_HD ViewNode MakeViewNode(const Vec3d& start, const Vec3d& dir, const Vec3d& sun,
+                                   const ViewPiece& pc, int64_t j, int64_t denom,
+                                   bool with_sun) const {
+        const double u = static_cast<double>(j) / static_cast<double>(denom);
+        double t, jac;
+        if (pc.low_at_a) {
+            t = pc.a + pc.span * u * u;
+            jac = 2.0 * pc.span * u;
+        } else {
+            t = pc.b - pc.span * (1.0 - u) * (1.0 - u);
+            jac = 2.0 * pc.span * (1.0 - u);
+        }
+        if (j == denom) t = pc.b;
+        const Densities d = GetDensities(atm, Length(start + dir * t) - atm.bottom_radius);
+        ViewNode node;
+        node.t = t;
+        node.tau = Vec3d(0.0);
+        node.sigma_t = Extinction(atm, d);
+        node.cdf = 0.0;
+        node.jac = jac;
+        node.rho_r = d.rayleigh;
+        node.rho_m = d.mie;
+        // The sun's transmittance just inside the piece at its ends (it
+        // jumps at a shadow crossing: each piece takes its side).
+        const double ts = j == 0 ? t + 1e-7 * pc.span : (j == denom ? t - 1e-7 * pc.span : t);
+        node.sun_t = with_sun ? SunTransmittanceAt(start + dir * ts, sun) : Vec3d(0.0);
+        return node;
+    }
+
     ATMOS_HD Vec3d SunTransmittanceAt(const Vec3d& p, const Vec3d& sun) const {
         const double r = Length(p);
-        return sun_table.Lookup(r, ClampCosine(Dot(p, sun) / r));
+        const double mu = ClampCosine(Dot(p, sun) / r);
+        if (sun_table.direct) {
+            if (RayIntersectsGround(r, mu, atm.bottom_radius)) return Vec3d(0.0);
+            const double rc = Min(r, atm.top_radius);
+            return Exp(-AdaptiveOpticalDepth(
+                atm, p * (rc / r), sun, DistanceToTopAtmosphereBoundary(rc, mu, atm.top_radius)));
+        }
+        return sun_table.Lookup(r, mu);
     }
 
     // Where p + t dir crosses the planet's shadow cylinder (radius bottom,
@@ -680,6 +859,23 @@ struct ReferenceEvaluator {
     // where the air is. Integrals over t are Simpson's rule in u with the
     // Jacobian dt/du (the integrand times it is smooth, also at u = 0); the
     // optical depth at odd nodes by the 3-point rule h/12 (5 g0 + 8 g1 - g2).
+    //
+    // Adaptive panels (issue 32): each Simpson panel (two intervals) is
+    // accepted only where it resolves the ray, else halved in u (depth first,
+    // in the order of t, so the optical depth at a panel's start is known):
+    // its optical depth must agree with the two half panels' (|S2 - S1| <= 15
+    // (1e-6 + 1e-4 S2), the adaptive Simpson test: a density whose scale is
+    // far below the piece's length, e.g. an 8 km scale height on a 1e9 m
+    // shell, is found and resolved), and its optical depth and the change of
+    // the sun's optical depth across it must stay below 0.5 (Simpson on
+    // exp(-tau) is then good to ~1e-4 of the panel). Where the light is
+    // already attenuated (the least attenuated channel's tau0 at the panel's
+    // start) the bounds grow by exp(tau0 / 5), which equidistributes the
+    // error exp(-tau0) dtau^5 over the ray: an optically thick ray (tau 277
+    // in issue 32's slab) needs ~20 panels near the camera instead of
+    // resolving all of it. At most kHybridNodeCapacity nodes and
+    // kMaxViewLevels halvings; panels the initial placement resolves are
+    // unchanged (Earth's views: the same nodes and sums as before).
     // with_order1 false: the table alone (no sun transmittances, *order1 0).
     ATMOS_HD int BuildViewTable(const Vec3d& start, const Vec3d& dir, const Vec3d& sun,
                                 double length, ViewNode* nodes, Vec3d* order1,
@@ -704,98 +900,158 @@ struct ReferenceEvaluator {
         const double nu = Dot(dir, sun);
         const double p_r = RayleighPhase(nu);
         const double p_m = MiePhase(atm, nu);
-        // Phase 1: nodes (positions, Jacobians, densities, sun transmittance).
+        // The initial intervals per piece (about kHybridViewIntervals in all,
+        // at most kHybridMaxNodes nodes); refinement may add up to the capacity.
+        ViewPiece pieces[5];
         int count = 0;
-        int piece_start[6], piece_n[6];
         for (int k = 0; k + 1 < nc; ++k) {
-            const double a = cuts[k], b = cuts[k + 1];
-            const double span = b - a;
-            int n = static_cast<int>(kHybridViewIntervals * span / length + 0.5);
+            ViewPiece& pc = pieces[k];
+            pc.a = cuts[k];
+            pc.b = cuts[k + 1];
+            pc.span = pc.b - pc.a;
+            int n = static_cast<int>(kHybridViewIntervals * pc.span / length + 0.5);
             n = Max(4, n + (n & 1));
             n = Min(n, kHybridMaxNodes - 1 - count - 4 * (nc - 2 - k));
             n -= n & 1;
-            const bool low_at_a = Length(start + dir * a) <= Length(start + dir * b);
-            piece_start[k] = count;
-            piece_n[k] = n;
-            for (int i = (k == 0 ? 0 : 1); i <= n; ++i) {
-                const double u = static_cast<double>(i) / n;
-                double t, jac;
-                if (low_at_a) {
-                    t = a + span * u * u;
-                    jac = 2.0 * span * u;
-                } else {
-                    t = b - span * (1.0 - u) * (1.0 - u);
-                    jac = 2.0 * span * (1.0 - u);
-                }
-                if (i == n) t = b;
-                const Vec3d x = start + dir * t;
-                const Densities d = GetDensities(atm, Length(x) - atm.bottom_radius);
-                ViewNode& node = nodes[count++];
-                node.t = t;
-                node.jac = jac;
-                node.rho_r = d.rayleigh;
-                node.rho_m = d.mie;
-                node.sigma_t = Extinction(atm, d);
-                // The sun's transmittance just inside the piece at its ends
-                // (it jumps at a shadow crossing: each piece takes its side).
-                const double ts = i == 0 ? t + 1e-7 * span : (i == n ? t - 1e-7 * span : t);
-                node.sun_t = with_order1 ? SunTransmittanceAt(start + dir * ts, sun) : Vec3d(0.0);
-            }
+            pc.n = n;
+            pc.low_at_a = Length(start + dir * pc.a) <= Length(start + dir * pc.b);
+            count += k == 0 ? n + 1 : n;
         }
-        // Phase 2: optical depths, order 1 and the first-vertex masses.
+        int spare = kHybridNodeCapacity - count;  // nodes refinement may still add
         Vec3d o1;
+        nodes[0] = MakeViewNode(start, dir, sun, pieces[0], 0, pieces[0].n, with_order1);
         nodes[0].tau = Vec3d(0.0);
         nodes[0].cdf = 0.0;
+        count = 1;
+        // Adds node `cur`'s first-vertex mass after node `prev`.
+        auto mass = [&](const ViewNode& prev, ViewNode* cur) {
+            const Vec3d sigma_s_prev =
+                atm.rayleigh_scattering * prev.rho_r + atm.mie_scattering * prev.rho_m;
+            const Vec3d sigma_s =
+                atm.rayleigh_scattering * cur->rho_r + atm.mie_scattering * cur->rho_m;
+            const double g0 = Dot(sigma_s_prev * Exp(-prev.tau), Vec3d(1.0 / 3.0));
+            const double g1 = Dot(sigma_s * Exp(-cur->tau), Vec3d(1.0 / 3.0));
+            cur->cdf = prev.cdf + 0.5 * (cur->t - prev.t) * (g0 + g1);
+        };
+        // Order 1's integrand at a node (times its Jacobian and weight later).
+        auto source = [&](const ViewNode& node, const Vec3d& sun_t) {
+            return (atm.rayleigh_scattering * (node.rho_r * p_r) +
+                    atm.mie_scattering * (node.rho_m * p_m)) *
+                   Exp(-node.tau) * sun_t;
+        };
         for (int k = 0; k + 1 < nc; ++k) {
-            const int s0 = k == 0 ? 0 : piece_start[k] - 1;  // the piece's node u = 0
-            const int n = piece_n[k];
-            const double h = 1.0 / n;
-            // The first node of a later piece is the previous piece's last
-            // node, except for its sun transmittance (the other side of a cut).
-            const Vec3d sun0 =
+            const ViewPiece& pc = pieces[k];
+            const double h0 = 1.0 / pc.n;
+            // The piece's u = 0 node is the previous piece's last node, except
+            // for its sun transmittance (the other side of a cut) and dt/du.
+            double start_jac = pc.low_at_a ? 0.0 : 2.0 * (cuts[k + 1] - cuts[k]);
+            Vec3d start_sun =
                 k == 0 || !with_order1
                     ? nodes[0].sun_t
                     : SunTransmittanceAt(start + dir * (cuts[k] + 1e-7 * (cuts[k + 1] - cuts[k])),
                                          sun);
-            // dt/du at the piece's u = 0 (the previous node holds the last
-            // piece's value there).
-            const bool low_at_a =
-                Length(start + dir * cuts[k]) <= Length(start + dir * cuts[k + 1]);
-            const double jac0 = low_at_a ? 0.0 : 2.0 * (cuts[k + 1] - cuts[k]);
-            for (int i = 0; i <= n; ++i) {
-                const ViewNode& node = nodes[s0 + i];
-                const double jac = i == 0 ? jac0 : node.jac;
-                const Vec3d sun_t = i == 0 ? sun0 : node.sun_t;
-                if (i > 0) {
-                    ViewNode& cur = nodes[s0 + i];
-                    const ViewNode& p1 = nodes[s0 + i - 1];
-                    const double j1 = i - 1 == 0 ? jac0 : p1.jac;
-                    if (i & 1) {
-                        const ViewNode& n1 = nodes[s0 + i + 1];
-                        cur.tau = p1.tau + (p1.sigma_t * (5.0 * j1) + cur.sigma_t * (8.0 * jac) -
-                                            n1.sigma_t * n1.jac) *
-                                               (h / 12.0);
-                    } else {
-                        const ViewNode& p2 = nodes[s0 + i - 2];
-                        const double j2 = i - 2 == 0 ? jac0 : p2.jac;
-                        cur.tau = p2.tau +
-                                  (p2.sigma_t * j2 + p1.sigma_t * (4.0 * j1) + cur.sigma_t * jac) *
-                                      (h / 3.0);
+            double pending_h = 0.0;  // the start node's weight from the panel before it
+            for (int p = 0; p < pc.n / 2; ++p) {
+                ViewPanel stack[kMaxViewLevels + 2];
+                int top = 0;
+                stack[top].level = 0;
+                stack[top].j0 = 2 * p;
+                stack[top].mid = MakeViewNode(start, dir, sun, pc, 2 * p + 1, pc.n, with_order1);
+                stack[top].end = MakeViewNode(start, dir, sun, pc, 2 * p + 2, pc.n, with_order1);
+                ++top;
+                while (top > 0) {
+                    const ViewPanel e = stack[--top];
+                    const int64_t denom = static_cast<int64_t>(pc.n) << e.level;
+                    const double h = h0 / static_cast<double>(int64_t(1) << e.level);
+                    const ViewNode& s = nodes[count - 1];
+                    if (e.level < kMaxViewLevels && spare >= 2) {
+                        ViewNode q1 =
+                            MakeViewNode(start, dir, sun, pc, 2 * e.j0 + 1, 2 * denom, false);
+                        ViewNode q3 =
+                            MakeViewNode(start, dir, sun, pc, 2 * e.j0 + 3, 2 * denom, false);
+                        const Vec3d g0 = s.sigma_t * start_jac, g2 = e.mid.sigma_t * e.mid.jac;
+                        const Vec3d g4 = e.end.sigma_t * e.end.jac;
+                        const Vec3d s1 = (g0 + g2 * 4.0 + g4) * (h / 3.0);
+                        const Vec3d s2 = (g0 + q1.sigma_t * (4.0 * q1.jac) + g2 * 2.0 +
+                                          q3.sigma_t * (4.0 * q3.jac) + g4) *
+                                         (h / 6.0);
+                        const double dtau = MaxComponent(s2);
+                        const double err = MaxComponent(Max(s2 - s1, s1 - s2));
+                        const double relax = exp(Min(MinComponent(s.tau), 60.0) / 5.0);
+                        // The trapezoid in t on the same five points: far from
+                        // Simpson's where a density concentrated near u = 0
+                        // (where dt/du vanishes) slipped between the points.
+                        const Vec3d trap = ((s.sigma_t + q1.sigma_t) * (q1.t - s.t) +
+                                            (q1.sigma_t + e.mid.sigma_t) * (e.mid.t - q1.t) +
+                                            (e.mid.sigma_t + q3.sigma_t) * (q3.t - e.mid.t) +
+                                            (q3.sigma_t + e.end.sigma_t) * (e.end.t - q3.t)) *
+                                           0.5;
+                        const double gross = MaxComponent(Max(trap - s2, s2 - trap));
+                        bool split = err > 15.0 * (kViewTauAbs + kViewTauRel * dtau) * relax ||
+                                     dtau > kViewMaxStep * relax ||
+                                     gross > (kViewGrossAbs + 0.5 * dtau) * relax;
+                        // The sun's optical depth across the panel, from the
+                        // geometry alone (so that the table is the same with
+                        // or without order 1, as the order-1 cache needs):
+                        // sigma_t |dr| / |mu_s| (plane-parallel; |mu_s| >= 0.05).
+                        if (!split) {
+                            const Vec3d xs = start + dir * s.t, xm = start + dir * e.mid.t;
+                            const double dr = Abs(Length(start + dir * e.end.t) - Length(xs));
+                            const double mu_s = Dot(xm, sun) / Length(xm);
+                            const double sigma =
+                                MaxComponent(Max(s.sigma_t, Max(e.mid.sigma_t, e.end.sigma_t)));
+                            split = sigma * dr / Max(Abs(mu_s), 0.05) > kViewMaxStep * relax;
+                        }
+                        if (split) {
+                            if (with_order1) {
+                                q1.sun_t = SunTransmittanceAt(start + dir * q1.t, sun);
+                                q3.sun_t = SunTransmittanceAt(start + dir * q3.t, sun);
+                            }
+                            spare -= 2;
+                            // Right half below, left half on top (done first).
+                            stack[top].level = e.level + 1;
+                            stack[top].j0 = 2 * e.j0 + 2;
+                            stack[top].mid = q3;
+                            stack[top].end = e.end;
+                            ++top;
+                            stack[top].level = e.level + 1;
+                            stack[top].j0 = 2 * e.j0;
+                            stack[top].mid = q1;
+                            stack[top].end = e.mid;
+                            ++top;
+                            continue;
+                        }
                     }
-                    const Vec3d sigma_s_prev =
-                        atm.rayleigh_scattering * p1.rho_r + atm.mie_scattering * p1.rho_m;
-                    const Vec3d sigma_s =
-                        atm.rayleigh_scattering * cur.rho_r + atm.mie_scattering * cur.rho_m;
-                    const double g0 = Dot(sigma_s_prev * Exp(-p1.tau), Vec3d(1.0 / 3.0));
-                    const double g1 = Dot(sigma_s * Exp(-cur.tau), Vec3d(1.0 / 3.0));
-                    cur.cdf = p1.cdf + 0.5 * (cur.t - p1.t) * (g0 + g1);
+                    // Accept the panel: its middle and end nodes.
+                    ViewNode& mid = nodes[count];
+                    ViewNode& end = nodes[count + 1];
+                    mid = e.mid;
+                    end = e.end;
+                    mid.tau = s.tau + (s.sigma_t * (5.0 * start_jac) +
+                                       mid.sigma_t * (8.0 * mid.jac) - end.sigma_t * end.jac) *
+                                          (h / 12.0);
+                    end.tau = s.tau + (s.sigma_t * start_jac + mid.sigma_t * (4.0 * mid.jac) +
+                                       end.sigma_t * end.jac) *
+                                          (h / 3.0);
+                    // Optical depth never decreases (the 3-point rule can
+                    // undershoot where the extinction rises steeply).
+                    mid.tau = Max(mid.tau, s.tau);
+                    end.tau = Max(end.tau, mid.tau);
+                    mass(s, &mid);
+                    mass(mid, &end);
+                    if (with_order1) {
+                        o1 += source(s, start_sun) * (start_jac * (pending_h + h) / 3.0);
+                        o1 += source(mid, mid.sun_t) * (mid.jac * 4.0 * h / 3.0);
+                    }
+                    count += 2;
+                    start_jac = end.jac;
+                    start_sun = end.sun_t;
+                    pending_h = h;
                 }
-                if (!with_order1) continue;
-                const double wgt = (i == 0 || i == n) ? 1.0 : ((i & 1) ? 4.0 : 2.0);
-                const Vec3d f = (atm.rayleigh_scattering * (node.rho_r * p_r) +
-                                 atm.mie_scattering * (node.rho_m * p_m)) *
-                                Exp(-nodes[s0 + i].tau) * sun_t;
-                o1 += f * (jac * wgt * h / 3.0);
+            }
+            if (with_order1) {
+                const ViewNode& last = nodes[count - 1];
+                o1 += source(last, last.sun_t) * (last.jac * pending_h / 3.0);
             }
         }
         *order1 = o1;
@@ -1047,7 +1303,7 @@ struct ReferenceEvaluator {
     ATMOS_HD void EvaluateHybrid(const Vec3d& start, const Vec3d& dir, const Vec3d& sun,
                                  double length, bool hits_ground, uint64_t key, Vec3d* sky,
                                  Vec3d* ground, Vec3d* tau_out) const {
-        ViewNode nodes[kHybridMaxNodes];
+        ViewNode nodes[kHybridNodeCapacity];
         Vec3d order1;
         int count = 1;
         if (length > 0.0) {
@@ -1159,7 +1415,7 @@ struct ReferenceEvaluator {
         if (estimator == ReferenceEstimator::kHybrid) {
             if (sample_count <= 0) {  // the transmittance alone: the same table
                 if (length > 0.0) {
-                    ViewNode nodes[kHybridMaxNodes];
+                    ViewNode nodes[kHybridNodeCapacity];
                     Vec3d order1;
                     const int n = BuildViewTable(start, dir, sun, length, nodes, &order1);
                     out.transmittance = Rgb(Exp(-nodes[n - 1].tau));
@@ -1171,7 +1427,7 @@ struct ReferenceEvaluator {
             out.transmittance = Rgb(Exp(-tau));
         } else {
             if (need_transmittance && length > 0.0) {
-                out.transmittance = Rgb(Exp(-OpticalDepth(atm, start, dir, length, 1024)));
+                out.transmittance = Rgb(Exp(-AdaptiveOpticalDepth(atm, start, dir, length)));
             }
             const int shell = seg.t_start > 0.0 ? shells.count - 1 : shells.ShellOf(Length(start));
             // Forced first collision unless the segment ends on a reflecting ground.
