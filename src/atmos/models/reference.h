@@ -66,7 +66,6 @@
 #include "atmos/model.h"
 #include "base/rng.h"
 #include "base/texture.h"
-#include "models/bruneton.h"
 #include "models/evaluator_model.h"
 #include "physics/density.h"
 #include "physics/geometry.h"
@@ -313,21 +312,6 @@ constexpr double kViewGrossAbs = 1e-4;
 constexpr double kViewMaxStep = 0.5;
 // The most next-event comb points per continuation segment.
 constexpr int kMaxNeeComb = 8;
-// The most candidate directions of the order-2 guide per first vertex.
-constexpr int kMaxGuideCandidates = 64;
-// The order-2 guide's modes (option `guide-mode`).
-enum class GuideMode : int {
-    // Resampled importance sampling of the first continuation direction.
-    kResample = 0,
-    // A control variate: the table's order 2 estimated from the candidates,
-    // Monte Carlo on the difference only.
-    kControlVariate = 1,
-};
-// The guide's defensive share: the resampling target is f (C + kGuideDefensive
-// mean C), so a direction the table misses keeps a pdf >= 1/(1 + 1/0.1) of
-// the phase function's, relative to the candidates' mean.
-constexpr double kGuideDefensive = 0.1;
-
 struct ReferenceEvaluator {
     static constexpr bool kStochastic = true;
 
@@ -359,16 +343,6 @@ struct ReferenceEvaluator {
     int nee_comb = 0;
     double sun_lobe = 0.0;
     double sun_lobe_g = 0.8;
-    // kHybrid: the order-2 guide (0: off): `guide_candidates` directions per
-    // first vertex, weighted by a table of single scattering (guide_lut:
-    // seed 004's single-scattering table, combined storage, built by
-    // BuildReferenceGuideLut), at first vertices with the sun below their
-    // horizon (or everywhere: guide_everywhere). See SampleGuidedDirection.
-    int guide_candidates = 0;
-    GuideMode guide_mode = GuideMode::kResample;
-    bool guide_everywhere = false;
-    BrunetonLut guide_lut;
-
     // kHybrid renders: order 1 of every pixel (sky + ground, per unit
     // irradiance; width x height x 3, texel (key % width, key / width)),
     // computed once per request and reused by every pass (order1_cached),
@@ -380,8 +354,6 @@ struct ReferenceEvaluator {
     void VisitTables(V& v) {
         v(sun_table.columns);
         v(order1_table);
-        v(guide_lut.transmittance_table);
-        v(guide_lut.scattering_table);
     }
 
     // 1: the sun is a point (directional light, as the other models); < 1: the
@@ -1199,96 +1171,6 @@ struct ReferenceEvaluator {
         return next;
     }
 
-    // The guide's single-scattered radiance C arriving at x from direction
-    // omega (the light a ray from x along omega gathers by one scattering,
-    // per unit irradiance; the volume only): seed 004's table lookup with
-    // both phase functions. Any C keeps the guided estimators unbiased; the
-    // closer to the true order 1 along omega, the lower their variance.
-    ATMOS_HD Vec3d GuideRadiance(const Vec3d& x, const Vec3d& omega, const Vec3d& sun) const {
-        const double r = Length(x);
-        const double mu = ClampCosine(Dot(x, omega) / r);
-        const double nu = ClampCosine(Dot(omega, sun));
-        Rgb mie;
-        const Rgb rayleigh =
-            guide_lut.CombinedScattering(r, mu, ClampCosine(Dot(x, sun) / r), nu,
-                                         RayIntersectsGround(r, mu, atm.bottom_radius), &mie);
-        return Vec3d(rayleigh) * RayleighPhase(nu) + Vec3d(mie) * MiePhase(atm, nu);
-    }
-
-    ATMOS_HD bool GuideApplies(const Vec3d& x, const Vec3d& sun) const {
-        return guide_candidates > 0 && (guide_everywhere || Dot(x, sun) < 0.0);
-    }
-
-    // The order-2 guide at a first vertex x (event chosen, throughput *w;
-    // f the event's phase function about dir). Candidates: n directions
-    // omega_i drawn from f (Rayleigh exactly, Mie by Henyey-Greenstein lobes,
-    // ratio r_i = f / pdf), stratified (a rank-1 lattice in the two uniform
-    // numbers with a random shift, so each is marginally distributed by the
-    // pdf); c_i = mean_c(w_c C_c(x, omega_i)).
-    //
-    // kResample (resampled importance sampling, Talbot et al. 2005): the
-    // returned direction is candidate j with probability ~ q_j = r_j (c_j +
-    // delta) (delta = kGuideDefensive mean_i r_i c_i), weighted by
-    // f / phat (omega_j) mean_i q_i = mean_i q_i / (c_j + delta), phat = f (c +
-    // delta). Given the candidates the expected estimate is the mean of the
-    // n phase-sampled estimates (1/n) sum_i r_i F(omega_i) whatever phat is
-    // (phat > 0), so the estimator is unbiased for every continuation F;
-    // it favours the directions where the table says order 2 comes from.
-    //
-    // kControlVariate: the returned direction is drawn as without the guide
-    // (SampleFirstDirection, independent of the candidates); *cv gets
-    // w (1/n) sum_i r_i C(omega_i) - w' C(omega) (w' the direction's weight):
-    // its expectation is 0, so adding it to the path's estimate keeps the
-    // mean and removes most of order 2's variance where C tracks it. Its
-    // samples can be negative.
-    ATMOS_HD Vec3d SampleGuidedDirection(const Vec3d& x, const Vec3d& dir, bool rayleigh,
-                                         const Vec3d& sun, Rng& rng, Vec3d* w, Vec3d* cv) const {
-        const int n = Min(guide_candidates, kMaxGuideCandidates);
-        const double xi1 = rng.Uniform(), xi2 = rng.Uniform();
-        const bool resample = guide_mode == GuideMode::kResample;
-        Vec3d cand[kMaxGuideCandidates];
-        double q[kMaxGuideCandidates];
-        double mean_c = 0.0;
-        Vec3d mean_cv;
-        for (int i = 0; i < n; ++i) {
-            const double u1 = (i + xi1) / n;
-            double u2 = xi2 + 0.6180339887498949 * i;
-            u2 -= floor(u2);
-            const double mu = rayleigh ? SampleRayleighCosine(u1) : SampleMiePhaseCosine(atm, u1);
-            const double ratio = rayleigh ? 1.0 : MiePhaseOverSamplingPdf(atm, mu);
-            cand[i] = MakeDirection(dir, mu, u2);
-            const Vec3d c = GuideRadiance(x, cand[i], sun);
-            if (resample) {
-                q[i] = ratio * Dot(*w, c) * (1.0 / 3.0);
-                mean_c += q[i];
-            } else {
-                mean_cv += c * ratio;
-            }
-        }
-        if (!resample) {
-            const Vec3d w_before = *w;
-            const Vec3d next = SampleFirstDirection(x, dir, rayleigh, sun, rng, w);
-            *cv = w_before * mean_cv * (1.0 / n) - *w * GuideRadiance(x, next, sun);
-            return next;
-        }
-        mean_c /= n;
-        const double delta = mean_c > 0.0 ? kGuideDefensive * mean_c : 1.0;
-        double total = 0.0;
-        for (int i = 0; i < n; ++i) {
-            const double mu = Dot(cand[i], dir);
-            const double ratio = rayleigh ? 1.0 : MiePhaseOverSamplingPdf(atm, mu);
-            q[i] += ratio * delta;
-            total += q[i];
-        }
-        double pick = rng.Uniform() * total;
-        int j = 0;
-        while (j + 1 < n && pick >= q[j]) pick -= q[j++];
-        const double ratio_j = rayleigh ? 1.0 : MiePhaseOverSamplingPdf(atm, Dot(cand[j], dir));
-        // f / phat mean_i q_i = ratio_j mean_i q_i / q_j.
-        *w = *w * (ratio_j * (total / n) / q[j]);
-        return cand[j];
-    }
-
     ATMOS_HD Vec3d SamplePhaseDirection(const Vec3d& dir, bool rayleigh, Rng& rng, Vec3d* w) const {
         if (rayleigh) {
             return MakeDirection(dir, SampleRayleighCosine(rng.Uniform()), rng.Uniform());
@@ -1384,11 +1266,7 @@ struct ReferenceEvaluator {
             const bool rayleigh = rng.Uniform() * (a_r + a_m) < a_r;
             Vec3d w =
                 w0 * (rayleigh ? sigma_r * ((a_r + a_m) / a_r) : sigma_m * ((a_r + a_m) / a_m));
-            Vec3d cv;
-            const Vec3d next = GuideApplies(x, sun)
-                                   ? SampleGuidedDirection(x, dir, rayleigh, sun, rng, &w, &cv)
-                                   : SampleFirstDirection(x, dir, rayleigh, sun, rng, &w);
-            *sky += cv;
+            const Vec3d next = SampleFirstDirection(x, dir, rayleigh, sun, rng, &w);
             HybridContinue(x, next, w, 1, sun, rng, sky);
         }
     }
@@ -1460,17 +1338,7 @@ struct ReferenceOptions {
     int nee_comb = 2;             // hybrid: comb points per continuation segment (twilight)
     double sun_lobe = 0.5;        // hybrid: the first direction's sun-lobe probability (twilight)
     double sun_lobe_g = 0.8;      // hybrid: its Henyey-Greenstein g
-    int guide = 0;                // hybrid: the order-2 guide's candidates (0: off)
-    GuideMode guide_mode = GuideMode::kResample;
-    int guide_everywhere = 0;  // 1: at every first vertex, 0: twilight ones only
 };
-
-// The order-2 guide's table (ReferenceEvaluator::GuideRadiance): seed 004's
-// transmittance and single-scattering tables (Rayleigh RGB and Mie red,
-// combined storage) for `atm`, built on the CPU into the two tables; the
-// returned lookup names them.
-BrunetonLut BuildReferenceGuideLut(const AtmosphereParameters& atm, Table* transmittance,
-                                   Table* scattering);
 
 // The sun's optical-depth table of the hybrid estimator: texels along x_mu and
 // x_r, and the Simpson intervals per texel (error bound: reference_test.cpp).
@@ -1512,8 +1380,6 @@ class ReferenceModel : public MonteCarloModel {
     // pixel setup's numbers as the key), reused by every pass of a render.
     mutable std::shared_ptr<const Table> order1_table_;
     mutable std::vector<double> order1_key_;
-    // The order-2 guide's tables (built on first use when the guide is on).
-    mutable Table guide_transmittance_, guide_scattering_;
     int shell_count_ = 48;
     bool sun_disc_light_ = false;
 };
