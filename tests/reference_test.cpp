@@ -551,14 +551,7 @@ struct HybridFixture {
         e.sun_lobe = options.sun_lobe;
         e.sun_lobe_g = options.sun_lobe_g;
         e.sun_table.Set(table.view(), atm);
-        e.guide_candidates = options.guide;
-        e.guide_mode = options.guide_mode;
-        e.guide_everywhere = options.guide_everywhere != 0;
-        if (options.guide > 0) {
-            e.guide_lut = BuildReferenceGuideLut(atm, &guide_transmittance, &guide_scattering);
-        }
     }
-    Table guide_transmittance, guide_scattering;
 };
 
 // Exact (Simpson, `intervals`) sun transmittance, 0 below the horizon.
@@ -863,44 +856,6 @@ int HybridBeyond(ReferenceEvaluator test, ReferenceEvaluator base, int max_order
     return beyond;
 }
 
-TEST(ReferenceHybrid, Order2GuideKeepsTheIntegral) {
-    // The order-2 guide (a table of single scattering weighting candidate
-    // directions at the first vertex), at every first vertex so that all 120
-    // queries (suns from -12 to 90 degrees) use it: resampled importance
-    // sampling and the control variate against the hybrid estimator without
-    // the guide, at max-order 2 (order 1 identical: the standard errors are
-    // the Monte Carlo part's, small enough to see a 2 % bias) and, for the
-    // resampling (whose weight carries every later order), with all orders.
-    // At most 1 % of the 360 channel means beyond 4 combined standard errors.
-    AtmosphereParameters atm = EarthAtmosphere();
-    atm.ground_albedo = Vec3d(0.3);
-    ReferenceOptions options;
-    const HybridFixture base(atm, 0, options);
-    options.guide = 8;
-    options.guide_everywhere = 1;
-    const HybridFixture guided_fixture(atm, 0, options);  // the tables, built once
-    for (const GuideMode mode : {GuideMode::kResample, GuideMode::kControlVariate}) {
-        ReferenceEvaluator guided = guided_fixture.e;
-        guided.guide_mode = mode;
-        for (const int max_order : {2, 0}) {
-            // The control variate's expectation is 0 in order 2 alone.
-            if (mode == GuideMode::kControlVariate && max_order == 0) continue;
-            double mean_z = 0.0;
-            const int beyond =
-                HybridBeyond(guided, base.e, max_order, max_order == 2 ? 32 : 16, &mean_z);
-            std::printf(
-                "guide mode %d, max-order %d vs no guide: %d of 360 beyond 4 standard "
-                "errors, mean difference %.3f standard errors\n",
-                static_cast<int>(mode), max_order, beyond, mean_z);
-            EXPECT_LE(beyond, 3) << static_cast<int>(mode) << " " << max_order;
-            // The mean of 360 differences in standard errors: about N(0, 1/360)
-            // without bias, N(0, 1/120) if a query's three channels moved together.
-            EXPECT_LE(std::abs(mean_z), 4.0 / std::sqrt(120.0))
-                << static_cast<int>(mode) << " " << max_order;
-        }
-    }
-}
-
 TEST(ReferenceHybrid, FirstDirectionWithSunLobeIsUnbiasedForTwoMieLobes) {
     // SampleFirstDirection at a twilight vertex (sun below its horizon: the
     // sun lobe's one-sample MIS with the Mie phase's lobe mixture): the mean
@@ -947,17 +902,15 @@ TEST(ReferenceHybrid, FirstDirectionWithSunLobeIsUnbiasedForTwoMieLobes) {
     EXPECT_NEAR(mc, want, 3e-3 * want);
 }
 
-TEST(ReferenceHybrid, SunLobeAndGuideKeepOrderTwoWithTwoMieLobes) {
+TEST(ReferenceHybrid, SunLobeKeepsOrderTwoWithTwoMieLobes) {
     // The first vertex's samplers with a two-lobe Mie phase (0.5 CS(0.3) +
     // 0.5 CS(0.94), a haze of 50 x Earth's aerosol without Rayleigh, so that
     // the Mie phase carries order 2): the sun lobe's mixture (phase
-    // mixture + sun lobe) and the guide's candidates (drawn from the lobes'
-    // mixture, resampled), each against the plain phase sampling, at max-order
-    // 2 as above: at most 1 % of the 360 channel means beyond 4 combined
-    // standard errors, and no drift of one sign. (It sees the guide's ratios
-    // taken for one lobe: mean difference 0.61 standard errors; not the sun
-    // lobe's pdf taken for one lobe, whose twilight vertices carry too little
-    // of order 2 here: the direct test above sees that.)
+    // mixture + sun lobe) against the plain phase sampling, at max-order 2
+    // as above: at most 1 % of the 360 channel means beyond 4 combined
+    // standard errors, and no drift of one sign. (Not the sun lobe's pdf
+    // taken for one lobe, whose twilight vertices carry too little of order 2
+    // here: the direct test above sees that.)
     AtmosphereParameters atm = EarthAtmosphere();
     atm.ground_albedo = Vec3d(0.3);
     atm.rayleigh_scattering = Vec3d(0.0);
@@ -971,19 +924,16 @@ TEST(ReferenceHybrid, SunLobeAndGuideKeepOrderTwoWithTwoMieLobes) {
     plain.sun_lobe = 0.0;
     ReferenceOptions lobe = plain;
     lobe.sun_lobe = 0.5;
-    ReferenceOptions guide = plain;
-    guide.guide = 8;
-    guide.guide_everywhere = 1;
     const HybridFixture base(atm, 2, plain);
-    for (const ReferenceOptions* options : {&lobe, &guide}) {
+    for (const ReferenceOptions* options : {&lobe}) {
         const HybridFixture test(atm, 2, *options);
         double mean_z = 0.0;
         const int beyond = HybridBeyond(test.e, base.e, 2, 32, &mean_z);
         std::printf(
-            "two Mie lobes, sun lobe %.2g guide %d vs plain (order 2): %d of 360 beyond 4 "
+            "two Mie lobes, sun lobe %.2g vs plain (order 2): %d of 360 beyond 4 "
             "standard errors, mean difference %.3f standard errors\n",
-            options->sun_lobe, options->guide, beyond, mean_z);
-        EXPECT_LE(beyond, 3) << options->sun_lobe << " " << options->guide;
+            options->sun_lobe, beyond, mean_z);
+        EXPECT_LE(beyond, 3) << options->sun_lobe;
         EXPECT_LE(std::abs(mean_z), 4.0 / std::sqrt(120.0)) << options->sun_lobe;
     }
 }

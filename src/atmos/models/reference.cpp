@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <mutex>
@@ -11,7 +12,6 @@
 
 #include "atmos/error.h"
 #include "base/parallel.h"
-#include "models/bruneton_stages.h"
 
 namespace atmos {
 
@@ -122,34 +122,33 @@ Table BuildSunColumnTable(const AtmosphereParameters& atm, int mu_size, int r_si
     return table;
 }
 
-BrunetonLut BuildReferenceGuideLut(const AtmosphereParameters& atm, Table* transmittance,
-                                   Table* scattering) {
-    BrunetonConfig config;  // seed 004's sizes
-    config.combined_mie = true;
-    config.scattering_samples = 50;  // seed 004's count (a guide needs no more)
-    BrunetonLut lut(atm, config);
-    transmittance->Resize(config.transmittance_width, config.transmittance_height, 1, 3);
-    const BrunetonTransmittanceStage stage{BrunetonMappingsOnly(lut), transmittance->out()};
-    ParallelFor(static_cast<int64_t>(config.transmittance_width) * config.transmittance_height, 64,
-                [&](int64_t item) { stage(item); });
-    lut.transmittance_table = transmittance->view();
-    Table rayleigh, mie;
-    ComputeBrunetonSingleScatteringRows(lut, &rayleigh, &mie);
-    scattering->Resize(rayleigh.width(), rayleigh.height(), rayleigh.depth(), 4);
-    for (int z = 0; z < rayleigh.depth(); ++z) {
-        for (int y = 0; y < rayleigh.height(); ++y) {
-            for (int x = 0; x < rayleigh.width(); ++x) {
-                float* out = scattering->Texel(x, y, z);
-                const float* r = rayleigh.Texel(x, y, z);
-                out[0] = r[0];
-                out[1] = r[1];
-                out[2] = r[2];
-                out[3] = mie.Texel(x, y, z)[0];
+bool SunTableResolves(const SunTransmittanceTable& table, const AtmosphereParameters& atm,
+                      double* worst) {
+    constexpr int kN = 64;
+    const double delta = atm.top_radius - atm.bottom_radius;
+    std::vector<double> err(kN, 0.0);
+    std::vector<char> ok(kN, 1);
+    ParallelFor(kN, 1, [&](int64_t i) {
+        const double x = static_cast<double>(i) / (kN - 1);
+        const double r = atm.bottom_radius + delta * x * x * x * x * (1.0 - 1e-9);
+        for (int j = 0; j < kN; ++j) {
+            const double y = (j + 0.5) / (kN / 2) - 1.0;
+            const double mu = y < 0.0 ? -y * y : y * y;
+            if (RayIntersectsGround(r, mu, atm.bottom_radius)) continue;
+            const Vec3d p(0.0, 0.0, r);
+            const Vec3d dir(std::sqrt(std::max(1.0 - mu * mu, 0.0)), 0.0, mu);
+            const Vec3d exact = Exp(-AdaptiveOpticalDepth(
+                atm, p, dir, DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius)));
+            const Vec3d t = table.Lookup(r, mu);
+            for (int c = 0; c < 3; ++c) {
+                const double d = std::abs(t[c] - exact[c]);
+                err[i] = std::max(err[i], d);
+                if (d > 1e-3 || (exact[c] > 0.01 && d > 1e-2 * exact[c])) ok[i] = 0;
             }
         }
-    }
-    lut.scattering_table = scattering->view();
-    return lut;
+    });
+    if (worst) *worst = *std::max_element(err.begin(), err.end());
+    return std::all_of(ok.begin(), ok.end(), [](char v) { return v != 0; });
 }
 
 std::shared_ptr<const Table> SharedSunColumnTable(const AtmosphereParameters& atm) {
@@ -228,19 +227,7 @@ const OptionTable<ReferenceOptions>& ReferenceModel::OptionRows() {
                   "Henyey-Greenstein lobe around the sun at a first vertex with the sun below "
                   "its horizon (twilight; MIS with the phase function; 0: none)")
             .Real("sun-lobe-g", &O::sun_lobe_g, 0.0, 0.99, "",
-                  "hybrid: the sun lobe's Henyey-Greenstein g")
-            .Integer("guide", &O::guide, 0, kMaxGuideCandidates, "",
-                     "hybrid: candidate directions per first vertex of the order-2 guide, a "
-                     "table of single scattering (seed 004's) that weights them (0: off)")
-            .Choice("guide-mode", &O::guide_mode,
-                    {{"resample", GuideMode::kResample}, {"cv", GuideMode::kControlVariate}},
-                    "hybrid: resample: the first continuation direction by resampled importance "
-                    "sampling of the candidates (unbiased); cv: the table's order 2 from the "
-                    "candidates as a control variate, Monte Carlo on the difference (unbiased; "
-                    "its samples can be negative)")
-            .Integer("guide-everywhere", &O::guide_everywhere, 0, 1, "",
-                     "hybrid: 1: the guide at every first vertex; 0: only where the sun is below "
-                     "the vertex's horizon (twilight)");
+                  "hybrid: the sun lobe's Henyey-Greenstein g");
     return table;
 }
 
@@ -259,9 +246,6 @@ ReferenceModel::ReferenceModel(const ReferenceOptions& options) : info_(StaticIn
     evaluator_.nee_comb = options.nee_comb;
     evaluator_.sun_lobe = options.sun_lobe;
     evaluator_.sun_lobe_g = options.sun_lobe_g;
-    evaluator_.guide_candidates = hybrid ? options.guide : 0;
-    evaluator_.guide_mode = options.guide_mode;
-    evaluator_.guide_everywhere = options.guide_everywhere != 0;
     sun_disc_light_ = options.sun_disc_light != 0;
     Prepare(EarthAtmosphere());
 }
@@ -283,11 +267,6 @@ void ReferenceModel::Prepare(const AtmosphereParameters& atmosphere) {
     order1_key_.clear();
     evaluator_.order1_table = TableView();
     evaluator_.order1_cached = false;
-    // Built on first use with the guide on (evaluator()); no table until then
-    // (a null view is not copied to a device).
-    guide_transmittance_ = Table();
-    guide_scattering_ = Table();
-    evaluator_.guide_lut = BrunetonLut();
 }
 
 const ReferenceEvaluator& ReferenceModel::evaluator() const {
@@ -295,10 +274,7 @@ const ReferenceEvaluator& ReferenceModel::evaluator() const {
     if (!sun_table_ready_ && evaluator_.estimator == ReferenceEstimator::kHybrid) {
         sun_table_ = SharedSunColumnTable(evaluator_.atm);
         evaluator_.sun_table.Set(sun_table_->view(), evaluator_.atm);
-        if (evaluator_.guide_candidates > 0) {
-            evaluator_.guide_lut =
-                BuildReferenceGuideLut(evaluator_.atm, &guide_transmittance_, &guide_scattering_);
-        }
+        evaluator_.sun_table.direct = !SunTableResolves(evaluator_.sun_table, evaluator_.atm);
     }
     sun_table_ready_ = true;
     return evaluator_;
@@ -315,10 +291,6 @@ std::string ReferenceModel::PassKey() const {
         key["nee_comb"] = evaluator_.nee_comb;
         key["sun_lobe"] = {evaluator_.sun_lobe, evaluator_.sun_lobe_g};
         key["sun_table"] = {kSunTableMuSize, kSunTableRSize, kSunTableIntervals};
-        if (evaluator_.guide_candidates > 0) {
-            key["guide"] = {evaluator_.guide_candidates, static_cast<int>(evaluator_.guide_mode),
-                            evaluator_.guide_everywhere};
-        }
     }
     key["sun_cone_cos"] = evaluator_.sun_cone_cos;
     key["shells"] = evaluator_.shells.count;
