@@ -1,4 +1,4 @@
-// atmos micro-benchmarks of `atmosphere-plus` (seed 000): precomputation time
+// atmos micro-benchmarks of `atmosphere-plus` (Boody's Atmosphere Plus notes): precomputation time
 // per scattering order and table size, and the per-call cost of the evaluator.
 //
 // Run: build/bench/atmos_bench --benchmark_filter=Aplus
@@ -34,7 +34,7 @@ void BM_AplusPrecompute(benchmark::State& state) {
     state.counters["table_MiB"] =
         static_cast<double>(t.scattering.size() * sizeof(float)) / (1024.0 * 1024.0);
 }
-// Table heights of seed 000 2.4 (width 32, depth 32), three orders.
+// Table heights of Boody's Atmosphere Plus notes 2.4 (width 32, depth 32), three orders.
 BENCHMARK(BM_AplusPrecompute)
     ->Args({64, 3})
     ->Args({128, 3})

@@ -5,7 +5,7 @@
 //        --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 // Transmittance and multiple scattering depend only on the atmosphere
 // (Prepare); the sky-view table and the aerial-perspective volume depend on
-// the camera and the sun, so they are per-frame work (seed 003 section 11.6
+// the camera and the sun, so they are per-frame work (Leenman's 2025 thesis section 11.6
 // counts the sky-view table as part of the render). A frame = BuildFrame +
 // the per-pixel loop; cameras outside the atmosphere (orbit, space) build no
 // frame tables and ray march every pixel.

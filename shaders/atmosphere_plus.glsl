@@ -1,12 +1,12 @@
 // atmos shaders: the `atmosphere-plus` model (J. Boody, "Atmosphere Plus"
-// notes, seed 000) over the tables of `atmos bake atmosphere-plus` (GLSL ES
+// notes, Boody's Atmosphere Plus notes) over the tables of `atmos bake atmosphere-plus` (GLSL ES
 // 3.00 and GLSL 3.30 core: no extensions).
 //
-// Written for atmos from seed 000's math (sections 1.7, 2.3, 2.4) and our C++
+// Written for atmos from Boody's Atmosphere Plus notes' math (sections 1.7, 2.3, 2.4) and our C++
 // code; every function names the C++ function in
 // src/atmos/models/atmosphere_plus.h (AtmospherePlusEvaluator, the table
 // lookups) or atmosphere_plus_mapping.h (AplusMapping: the four
-// parameterizations) it mirrors and the seed 000 section it implements.
+// parameterizations) it mirrors and Boody's Atmosphere Plus notes section it implements.
 //
 // Use: include, in this order,
 //   1. the #version line and `precision highp float; precision highp sampler3D;`
@@ -26,10 +26,10 @@
 // float16 tables filter everywhere.
 //
 // Units: metres, planet-centred positions. Results per unit solar irradiance
-// (seed 000 2.3 factors I_I out: multiply by ATMOS_SOLAR_IRRADIANCE, the
+// (Boody's Atmosphere Plus notes 2.3 factors I_I out: multiply by ATMOS_SOLAR_IRRADIANCE, the
 // atmosphere's, times the scene's).
 //
-// Tables: texel i holds the value at i / (size - 1) (seed 000 2.4), i.e. the
+// Tables: texel i holds the value at i / (size - 1) (Boody's Atmosphere Plus notes 2.4), i.e. the
 // unit coordinate t sits at atmos_TextureCoord(t, size). The altitude axis is
 // not filtered by the sampler: as the C++ (AplusSampleTable) the lookup blends
 // the two altitude rows around h, each sampled (bilinear in v, w) at the v of
@@ -38,22 +38,22 @@
 uniform highp sampler3D atmos_scattering_texture;
 uniform highp sampler2D atmos_transmittance_texture;
 
-// ---- the parameterizations (seed 000 section 2.4; atmosphere_plus_mapping.h) ----
+// ---- the parameterizations (Boody's Atmosphere Plus notes section 2.4; atmosphere_plus_mapping.h) ----
 
 // AplusPow: x^p for x >= 0, exact for the seed's powers 1, 2, 3.
 float atmos_AplusPow(float x, float p) {
     return p == 1.0 ? x : p == 2.0 ? x * x : p == 3.0 ? x * x * x : pow(x, p);
 }
-// AplusRoot: x^(1/p) for x >= 0 (seed 000 2.4.2-2.4.3).
+// AplusRoot: x^(1/p) for x >= 0 (Boody's Atmosphere Plus notes 2.4.2-2.4.3).
 float atmos_AplusRoot(float x, float p) {
     return p == 1.0 ? x : p == 2.0 ? sqrt(x) : x > 0.0 ? pow(x, 1.0 / p) : 0.0;
 }
-// AplusSignedRoot: sign(c) |c|^(1/p) (seed 000 2.4.3).
+// AplusSignedRoot: sign(c) |c|^(1/p) (Boody's Atmosphere Plus notes 2.4.3).
 float atmos_AplusSignedRoot(float c, float p) {
     float a = atmos_AplusRoot(abs(c), p);
     return c < 0.0 ? -a : a;
 }
-// AplusMapping::HorizonCosine (seed 000 2.4.4): the cosine of the horizon's
+// AplusMapping::HorizonCosine (Boody's Atmosphere Plus notes 2.4.4): the cosine of the horizon's
 // view-zenith angle at altitude h. Geometric: -sqrt(1 - (R/(R+h))^2), written
 // -sqrt(h (2R + h)) / (R + h) so that float keeps it for small h; the seed's
 // -1 + R/(R+h) as -h / (R + h).
@@ -66,7 +66,7 @@ float atmos_AplusHorizonCosine(float h) {
     return -sqrt(h * (2.0 * ATMOS_BOTTOM_RADIUS + h)) / r;
 #endif
 }
-// AplusMapping::U (seed 000 2.4.1-2.4.4): u = (h / H_a)^(1/p_u).
+// AplusMapping::U (Boody's Atmosphere Plus notes 2.4.1-2.4.4): u = (h / H_a)^(1/p_u).
 float atmos_AplusU(float h) {
     return atmos_AplusRoot(clamp(h / (ATMOS_TOP_RADIUS - ATMOS_BOTTOM_RADIUS), 0.0, 1.0),
                            ATMOS_APLUS_POWER_U);
@@ -151,14 +151,14 @@ vec4 atmos_AplusScattering(float h, float mu, float mu_s) {
     return atmos_AplusSampleTable(false, h, mu, w, vec4(0.0));
 }
 // AplusSampleTransmittance: the transmittance of the view segment from
-// altitude h along mu (seed 000 1.10; 1 below the horizon at the ground row).
+// altitude h along mu (Boody's Atmosphere Plus notes 1.10; 1 below the horizon at the ground row).
 vec3 atmos_AplusTransmittance(float h, float mu) {
     return atmos_AplusSampleTable(true, h, mu, 0.5, vec4(1.0)).rgb;
 }
 
-// ---- rendering (seed 000 sections 1.7, 2.3, 2.4) ----
+// ---- rendering (Boody's Atmosphere Plus notes sections 1.7, 2.3, 2.4) ----
 
-// AplusRayleighPhase / AplusModifiedRayleighPhase (seed 000 1.7, normalised
+// AplusRayleighPhase / AplusModifiedRayleighPhase (Boody's Atmosphere Plus notes 1.7, normalised
 // to 4 pi; ATMOS_APLUS_MODIFIED_RAYLEIGH: 0.8 (1.4 + 0.5 nu^2)).
 float atmos_AplusRayleighPhase(float nu) {
 #if ATMOS_APLUS_MODIFIED_RAYLEIGH
@@ -167,7 +167,7 @@ float atmos_AplusRayleighPhase(float nu) {
     return 0.75 * (1.0 + nu * nu);
 #endif
 }
-// AplusMiePhase (seed 000 1.7): 4 pi x the Cornette-Shanks phase function.
+// AplusMiePhase (Boody's Atmosphere Plus notes 1.7): 4 pi x the Cornette-Shanks phase function.
 float atmos_AplusMiePhase(float nu) { return 4.0 * ATMOS_PI * atmos_MiePhase(nu); }
 
 // The Lambertian ground at point g lit by the sun through the transmittance
@@ -180,7 +180,7 @@ vec3 atmos_AplusGround(vec3 g, vec3 sun) {
 
 // AtmospherePlusEvaluator::Evaluate: what `atmos render` computes per pixel,
 // per unit solar irradiance. P_0 is the camera, or where the ray enters the
-// atmosphere (seed 000 2.4); sky = F_R(nu) I_R + F_M(nu) I_M with nu =
+// atmosphere (Boody's Atmosphere Plus notes 2.4); sky = F_R(nu) I_R + F_M(nu) I_M with nu =
 // dot(L, -V) = dot(sun, V) (2.3); the transmittance of the view segment; the
 // lit ground attenuated to the camera (a camera on the ground looking down
 // sees the ground at its feet through no air).

@@ -1,11 +1,11 @@
 // atmos shaders: the `bruneton` model's rendering functions over the tables of
 // `atmos bake bruneton` (GLSL ES 3.00 and GLSL 3.30 core: no extensions).
 //
-// Written for atmos from the math of seed 004 (Bruneton 2017, "Precomputed
-// atmospheric scattering: a new implementation") and our C++ code; every
+// Written for atmos from the math of Bruneton 2017, "Precomputed
+// atmospheric scattering: a new implementation" and our C++ code; every
 // function names the C++ function in src/atmos/models/bruneton.h (struct
 // BrunetonLut / BrunetonEvaluator) or src/atmos/physics/ it mirrors and the
-// seed 004 section it implements. It is not Bruneton's published GLSL.
+// Bruneton's 2017 implementation notes section it implements. It is not Bruneton's published GLSL.
 //
 // Use: include, in this order,
 //   1. the #version line and `precision highp float; precision highp sampler3D;`
@@ -41,7 +41,7 @@ uniform highp sampler3D atmos_single_mie_texture;
 
 // ---- geometry (BrunetonLut; the shared helpers are in common.glsl) ----
 
-// BrunetonLut::ClampRadius (seed 004 ClampRadius).
+// BrunetonLut::ClampRadius (Bruneton's 2017 implementation notes ClampRadius).
 float atmos_ClampRadius(float r) { return clamp(r, ATMOS_BOTTOM_RADIUS, ATMOS_TOP_RADIUS); }
 // BrunetonLut::HorizonH: distance to the top for a horizontal ray on the ground.
 float atmos_HorizonH() {
@@ -51,7 +51,7 @@ float atmos_HorizonH() {
 float atmos_Rho(float r) {
     return atmos_SafeSqrt((r - ATMOS_BOTTOM_RADIUS) * (r + ATMOS_BOTTOM_RADIUS));
 }
-// DistanceToBottomAtmosphereBoundary (seed 004, same section).
+// DistanceToBottomAtmosphereBoundary (Bruneton's 2017 implementation notes, same section).
 float atmos_DistanceToBottom(float r, float mu) {
     float disc = (ATMOS_BOTTOM_RADIUS - r) * (ATMOS_BOTTOM_RADIUS + r) + (r * mu) * (r * mu);
     return max(-r * mu - atmos_SafeSqrt(disc), 0.0);
@@ -62,9 +62,9 @@ float atmos_SmoothStep(float e0, float e1, float x) {
     return t * t * (3.0 - 2.0 * t);
 }
 
-// ---- transmittance (seed 004 "Transmittance": precomputation and lookup) ----
+// ---- transmittance (Bruneton's 2017 implementation notes "Transmittance": precomputation and lookup) ----
 
-// BrunetonLut::TransmittanceUvFromRMu (seed 004 GetTransmittanceTextureUvFromRMu).
+// BrunetonLut::TransmittanceUvFromRMu (Bruneton's 2017 implementation notes GetTransmittanceTextureUvFromRMu).
 vec2 atmos_TransmittanceUv(float r, float mu) {
     float H = atmos_HorizonH();
     float rho = atmos_Rho(r);
@@ -76,7 +76,7 @@ vec2 atmos_TransmittanceUv(float r, float mu) {
     return vec2(atmos_TextureCoord(x_mu, float(ATMOS_TRANSMITTANCE_WIDTH)),
                 atmos_TextureCoord(x_r, float(ATMOS_TRANSMITTANCE_HEIGHT)));
 }
-// BrunetonLut::TransmittanceToTop (seed 004 GetTransmittanceToTopAtmosphereBoundary).
+// BrunetonLut::TransmittanceToTop (Bruneton's 2017 implementation notes GetTransmittanceToTopAtmosphereBoundary).
 vec3 atmos_TransmittanceToTop(float r, float mu) {
     vec2 uv = atmos_TransmittanceUv(atmos_ClampRadius(r), atmos_ClampCosine(mu));
     return texture(atmos_transmittance_texture, uv).rgb;
@@ -87,7 +87,7 @@ vec3 atmos_SafeRatio(vec3 num, vec3 den) {
     for (int i = 0; i < 3; ++i) t[i] = den[i] > 0.0 ? clamp(num[i] / den[i], 0.0, 1.0) : 0.0;
     return t;
 }
-// BrunetonLut::Transmittance (seed 004 GetTransmittance): between (r, mu) and
+// BrunetonLut::Transmittance (Bruneton's 2017 implementation notes GetTransmittance): between (r, mu) and
 // the point at distance d; the caller says whether the ray hits the ground.
 vec3 atmos_Transmittance(float r, float mu, float d, bool ray_r_mu_intersects_ground) {
     float r_d = atmos_ClampRadius(sqrt(d * d + 2.0 * r * mu * d + r * r));
@@ -98,7 +98,7 @@ vec3 atmos_Transmittance(float r, float mu, float d, bool ray_r_mu_intersects_gr
     }
     return atmos_SafeRatio(atmos_TransmittanceToTop(r, mu), atmos_TransmittanceToTop(r_d, mu_d));
 }
-// BrunetonLut::TransmittanceToSun (seed 004 GetTransmittanceToSun): the visible
+// BrunetonLut::TransmittanceToSun (Bruneton's 2017 implementation notes GetTransmittanceToSun): the visible
 // fraction of the sun's disc above the horizon as a smoothstep.
 vec3 atmos_TransmittanceToSun(float r, float mu_s) {
     float sin_theta_h = ATMOS_BOTTOM_RADIUS / r;
@@ -109,9 +109,9 @@ vec3 atmos_TransmittanceToSun(float r, float mu_s) {
     return atmos_TransmittanceToTop(r, mu_s) * f;
 }
 
-// ---- scattering (seed 004 "Single scattering": the 4D texture and its lookup) ----
+// ---- scattering (Bruneton's 2017 implementation notes "Single scattering": the 4D texture and its lookup) ----
 
-// BrunetonLut::ScatteringUvwz (seed 004 GetScatteringTextureUvwzFromRMuMuSNu):
+// BrunetonLut::ScatteringUvwz (Bruneton's 2017 implementation notes GetScatteringTextureUvwzFromRMuMuSNu):
 // (u_nu, u_mu_s, u_mu, u_r); mu split at the horizon.
 vec4 atmos_ScatteringUvwz(float r, float mu, float mu_s, float nu,
                           bool ray_r_mu_intersects_ground) {
@@ -146,7 +146,7 @@ vec4 atmos_ScatteringUvwz(float r, float mu, float mu_s, float nu,
     float u_nu = (nu + 1.0) / 2.0;
     return vec4(u_nu, u_mu_s, u_mu, u_r);
 }
-// BrunetonLut::Lookup4D (seed 004 GetScattering): the 4D table as NU slices of
+// BrunetonLut::Lookup4D (Bruneton's 2017 implementation notes GetScattering): the 4D table as NU slices of
 // MU_S texels side by side in x; two trilinear lookups blended along nu.
 vec4 atmos_Lookup4D(highp sampler3D table, vec4 uvwz) {
     float nu_size = float(ATMOS_SCATTERING_NU);
@@ -157,14 +157,14 @@ vec4 atmos_Lookup4D(highp sampler3D table, vec4 uvwz) {
     vec3 uvw1 = vec3((tex_x + 1.0 + uvwz.y) / nu_size, uvwz.z, uvwz.w);
     return texture(table, uvw0) * (1.0 - lerp) + texture(table, uvw1) * lerp;
 }
-// BrunetonLut::ExtrapolatedSingleMie (seed 004 GetExtrapolatedSingleMieScattering).
+// BrunetonLut::ExtrapolatedSingleMie (Bruneton's 2017 implementation notes GetExtrapolatedSingleMieScattering).
 vec3 atmos_ExtrapolatedSingleMie(vec4 s) {
     if (s.r <= 0.0) return vec3(0.0);
     vec3 ratio = ATMOS_MIE_SCATTERING / ATMOS_RAYLEIGH_SCATTERING *
                  (ATMOS_RAYLEIGH_SCATTERING.r / ATMOS_MIE_SCATTERING.r);
     return s.rgb * (s.a / s.r) * ratio;
 }
-// BrunetonLut::CombinedScattering (seed 004 GetCombinedScattering): Rayleigh +
+// BrunetonLut::CombinedScattering (Bruneton's 2017 implementation notes GetCombinedScattering): Rayleigh +
 // multiple scattering (returned) and the single Mie scattering, no phase.
 vec3 atmos_CombinedScattering(float r, float mu, float mu_s, float nu,
                               bool ray_r_mu_intersects_ground, out vec3 single_mie) {
@@ -180,9 +180,9 @@ vec3 atmos_CombinedScattering(float r, float mu, float mu_s, float nu,
     return s.rgb;
 }
 
-// ---- irradiance (seed 004 "Ground irradiance") ----
+// ---- irradiance (Bruneton's 2017 implementation notes "Ground irradiance") ----
 
-// BrunetonLut::IrradianceUvFromRMuS + GetIrradiance (seed 004 GetIrradiance).
+// BrunetonLut::IrradianceUvFromRMuS + GetIrradiance (Bruneton's 2017 implementation notes GetIrradiance).
 vec3 atmos_GetIrradiance(float r, float mu_s) {
     float x_r = (r - ATMOS_BOTTOM_RADIUS) / (ATMOS_TOP_RADIUS - ATMOS_BOTTOM_RADIUS);
     float x_mu_s = mu_s * 0.5 + 0.5;
@@ -191,9 +191,9 @@ vec3 atmos_GetIrradiance(float r, float mu_s) {
     return texture(atmos_irradiance_texture, uv).rgb;
 }
 
-// ---- rendering (seed 004 "Rendering") ----
+// ---- rendering (Bruneton's 2017 implementation notes "Rendering") ----
 
-// BrunetonLut::SkyRadiance (seed 004 GetSkyRadiance): radiance of the sky along
+// BrunetonLut::SkyRadiance (Bruneton's 2017 implementation notes GetSkyRadiance): radiance of the sky along
 // view_ray (unit) from camera, per unit solar irradiance; transmittance to
 // space in `transmittance`. A camera in space is moved to the top of the
 // atmosphere; a ray that misses it gets L = 0, T = 1. `ray_hits_ground`: the
@@ -225,7 +225,7 @@ vec3 atmos_SkyRadiance(vec3 camera, vec3 view_ray, float shadow_length, vec3 sun
     if (shadow_length == 0.0) {
         scattering = atmos_CombinedScattering(r, mu, mu_s, nu, ray_hits_ground, single_mie);
     } else {
-        // Light shafts (seed 004; Bruneton & Neyret 2008 Eq. 18): omit the first l metres.
+        // Light shafts (Bruneton's 2017 implementation notes; Bruneton & Neyret 2008 Eq. 18): omit the first l metres.
         float d = shadow_length;
         float r_p = atmos_ClampRadius(sqrt(d * d + 2.0 * r * mu * d + r * r));
         float mu_p = (r * mu + d) / r_p;
@@ -264,7 +264,7 @@ vec3 atmos_SegmentSingleMie(float r, float mu, float mu_s, float nu, float d) {
     return sum * ATMOS_MIE_SCATTERING;
 }
 
-// BrunetonLut::SkyRadianceToPoint (seed 004 GetSkyRadianceToPoint): the
+// BrunetonLut::SkyRadianceToPoint (Bruneton's 2017 implementation notes GetSkyRadianceToPoint): the
 // scattering between camera and point (aerial perspective) as the difference
 // of two lookups; the transmittance between them in `transmittance`.
 vec3 atmos_SkyRadianceToPoint(vec3 camera, vec3 point, float shadow_length, vec3 sun_direction,
@@ -302,7 +302,7 @@ vec3 atmos_SkyRadianceToPoint(vec3 camera, vec3 point, float shadow_length, vec3
 #if ATMOS_COMBINED_MIE
     single_mie = atmos_ExtrapolatedSingleMie(vec4(scattering, single_mie.r));
 #endif
-    // Seed 004 fades single Mie out below mu_s = 0.01 (its hack against the
+    // Bruneton's 2017 implementation notes fades single Mie out below mu_s = 0.01 (its hack against the
     // lookups' difference artefacts); by default (ATMOS_LOW_SUN_MIE 0) the
     // faded part is the single Mie integral along the segment (issue 15).
     float fade = atmos_SmoothStep(0.0, 0.01, mu_s);
@@ -318,7 +318,7 @@ vec3 atmos_SkyRadianceToPoint(vec3 camera, vec3 point, float shadow_length, vec3
            max(single_mie, vec3(0.0)) * atmos_MiePhase(nu);
 }
 
-// BrunetonLut::SunAndSkyIrradiance (seed 004 GetSunAndSkyIrradiance): the sun's
+// BrunetonLut::SunAndSkyIrradiance (Bruneton's 2017 implementation notes GetSunAndSkyIrradiance): the sun's
 // irradiance at `point` on a surface with `normal` (returned) and the sky's
 // (`sky_irradiance`: the horizontal-surface table times (1 + n.up) / 2).
 vec3 atmos_SunAndSkyIrradiance(vec3 point, vec3 normal, vec3 sun_direction,

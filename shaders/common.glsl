@@ -2,7 +2,7 @@
 // (GLSL ES 3.00 and GLSL 3.30 core: no extensions).
 //
 // Written for atmos from our C++ (include/atmos/math.h, src/atmos/physics/
-// geometry.h, phase.h, density.h) and the math of seed 004 (Bruneton 2017);
+// geometry.h, phase.h, density.h) and the math of Bruneton 2017;
 // every function names the C++ function it mirrors. GLSL has no #include:
 // `atmos bake` installs this file as DIR/shaders/common.glsl and a program
 // concatenates, in this order,
@@ -24,12 +24,12 @@ const float ATMOS_PI = 3.14159265358979;
 float atmos_SafeSqrt(float x) { return sqrt(max(x, 0.0)); }
 // ClampCosine (math.h).
 float atmos_ClampCosine(float mu) { return clamp(mu, -1.0, 1.0); }
-// GetTextureCoordFromUnitRange (base/texture.h; seed 004 "Precomputation"):
+// GetTextureCoordFromUnitRange (base/texture.h; Bruneton's 2017 implementation notes "Precomputation"):
 // [0, 1] onto the texel centres of a texture of n texels.
 float atmos_TextureCoord(float x, float n) { return 0.5 / n + x * (1.0 - 1.0 / n); }
-// RayleighPhase (physics/phase.h; seed 004 RayleighPhaseFunction).
+// RayleighPhase (physics/phase.h; Bruneton's 2017 implementation notes RayleighPhaseFunction).
 float atmos_RayleighPhase(float nu) { return 3.0 / (16.0 * ATMOS_PI) * (1.0 + nu * nu); }
-// CornetteShanksPhase (phase.h; seed 004 MiePhaseFunction).
+// CornetteShanksPhase (phase.h; Bruneton's 2017 implementation notes MiePhaseFunction).
 float atmos_CornetteShanksPhase(float g, float nu) {
     float k = 3.0 / (8.0 * ATMOS_PI) * (1.0 - g * g) / (2.0 + g * g);
     float denom = 1.0 + g * g - 2.0 * g * nu;
@@ -47,7 +47,7 @@ float atmos_MiePhase(float nu) {
     return atmos_CornetteShanksPhase(ATMOS_MIE_PHASE_G, nu);
 #endif
 }
-// DistanceToTopAtmosphereBoundary (geometry.h; seed 004 "Distance to the top
+// DistanceToTopAtmosphereBoundary (geometry.h; Bruneton's 2017 implementation notes "Distance to the top
 // atmosphere boundary"): discriminant r^2 (mu^2 - 1) + top^2.
 float atmos_DistanceToTop(float r, float mu) {
     float disc = (ATMOS_TOP_RADIUS - r) * (ATMOS_TOP_RADIUS + r) + (r * mu) * (r * mu);
@@ -113,7 +113,7 @@ bool atmos_BeginRay(vec3 camera, vec3 dir, out vec3 sky, out vec3 ground,
 bool atmos_GroundReflects() {
     return max(ATMOS_GROUND_ALBEDO.r, max(ATMOS_GROUND_ALBEDO.g, ATMOS_GROUND_ALBEDO.b)) > 0.0;
 }
-// GetLayerDensity / GetProfileDensity (physics/density.h; seed 004): a layer is
+// GetLayerDensity / GetProfileDensity (physics/density.h; Bruneton's 2017 implementation notes): a layer is
 // vec4(exp_term, exp_scale, linear_term, constant_term); a zero exp_term has no
 // exponential (0 * exp(large) would be NaN).
 float atmos_LayerDensity(vec4 l, float altitude) {

@@ -49,7 +49,7 @@ const float ATMOS_SKY_VIEW_MIN_ALTITUDE = 1.0;
 
 // ---- geometry (the shared helpers are in common.glsl) ----
 
-// RayIntersectsGround (geometry.h; seed 004).
+// RayIntersectsGround (geometry.h; Bruneton's 2017 implementation notes).
 bool atmos_RayIntersectsGround(float r, float mu) {
     return mu < 0.0 &&
            (ATMOS_BOTTOM_RADIUS - r) * (ATMOS_BOTTOM_RADIUS + r) + (r * mu) * (r * mu) >= 0.0;
@@ -57,7 +57,7 @@ bool atmos_RayIntersectsGround(float r, float mu) {
 
 // ---- baked tables (paper sections 5.1, 5.5.2) ----
 
-// HillaireTransmittanceUv (seed 004 GetTransmittanceTextureUvFromRMu) and the
+// HillaireTransmittanceUv (Bruneton's 2017 implementation notes GetTransmittanceTextureUvFromRMu) and the
 // lookup HillaireEvaluator::Transmittance: T(r, mu) to the top.
 vec3 atmos_Transmittance(float r, float mu) {
     r = clamp(r, ATMOS_BOTTOM_RADIUS, ATMOS_TOP_RADIUS);
@@ -71,7 +71,7 @@ vec3 atmos_Transmittance(float r, float mu) {
                    atmos_TextureCoord(rho / H, float(ATMOS_TRANSMITTANCE_HEIGHT)));
     return texture(atmos_transmittance_texture, uv).rgb;
 }
-// HillaireEvaluator::TransmittanceToGround (seed 004 GetTransmittance, ray to the ground).
+// HillaireEvaluator::TransmittanceToGround (Bruneton's 2017 implementation notes GetTransmittance, ray to the ground).
 vec3 atmos_TransmittanceToGround(float r, float mu, float d) {
     float r_d = clamp(sqrt(d * d + 2.0 * r * mu * d + r * r), ATMOS_BOTTOM_RADIUS, ATMOS_TOP_RADIUS);
     float mu_d = atmos_ClampCosine((r * mu + d) / r_d);

@@ -65,7 +65,7 @@ TEST(AnalyticFlat, HomogeneousSlabMatchesEq47) {
 TEST(AnalyticFlat, Eq51IsExactAtZenithAndOverestimatesAtTheHorizon) {
     // Eq. 51 looking straight up equals the exponential's column H exactly
     // (to 1e-3 here); at the horizon it is sqrt(2 r H) against sqrt(pi r H / 2):
-    // 12.8% more (seed 003 s. 12.2: "slightly more absorption near the horizon").
+    // 12.8% more (Leenman's 2025 thesis s. 12.2: "slightly more absorption near the horizon").
     for (double H : {8000.0, 1200.0}) {
         EXPECT_NEAR(FlatLengthUp(kR, 1.0, H, kR) / ToInfinity(kR, 1.0, H), 1.0, 1e-3);
         const double horizon = FlatLengthUp(kR, 0.0, H, kR) / ToInfinity(kR, 0.0, H);
@@ -93,7 +93,7 @@ TEST(AnalyticFlat, OzoneShellOfEarthIsEq59AndItsChordIsExact) {
     EXPECT_TRUE(MakeOzoneShell(LoadAtmosphere("mars")).Empty());
 }
 
-// The Chapman approximation (seed 003 Eq. 24-25) against the numerical
+// The Chapman approximation (Leenman's 2025 thesis Eq. 24-25) against the numerical
 // integral. Bounds found (and written in docs/models/analytic.md), viewer at 0-20 km:
 //   seed unit (Eq. 25 as printed, c = sqrt(r / H)): above the horizon up to
 //   24.1% (near mu = 0.01-0.03; 3.4% at the zenith for H = 8 km; 20.2% at the

@@ -105,7 +105,7 @@ TEST(AtmospherePlusStages, GatherStageMatchesTheFormerFormulation) {
 
 // With a constant incoming intensity (1 in every channel) the gather is the
 // integral of the phase functions over the sphere, 4 pi for both in the seed's
-// normalisation (seed 000 1.7); the 2D trapezoidal rule converges to it.
+// normalisation (Boody's Atmosphere Plus notes 1.7); the 2D trapezoidal rule converges to it.
 TEST(AtmospherePlusStages, GatherOfAConstantIntensityIsTheIntegralOfThePhase) {
     AtmosphereParameters atm = LoadAtmosphere("earth-atmosphere-plus");
     atm.mie_phase_g = 0.3;  // a smooth Mie lobe, resolved by the grid below

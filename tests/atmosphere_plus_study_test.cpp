@@ -1,4 +1,4 @@
-// The question seed 000 section 2.4 leaves open, measured: which
+// The question Boody's Atmosphere Plus notes section 2.4 leaves open, measured: which
 // parameterization and table size gives the lowest error for a memory budget.
 //
 // Not part of the default run (minutes of work): run it with

@@ -1,5 +1,5 @@
-// Tests of the `atmosphere-plus` model (seed 000): mappings, integration rules,
-// tables against direct integration, scattering orders, rendering.
+// Tests of the `atmosphere-plus` model (Boody's Atmosphere Plus notes): mappings, integration
+// rules, tables against direct integration, scattering orders, rendering.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -132,12 +132,13 @@ TEST(AtmospherePlus, LinearAndNonlinearMappingsAreTheSeedFormulas) {
     const AplusMapping non = MakeMapping(AplusParameterization::kNonlinear);
     for (double h : {0.0, 2500.0, 50e3, 100e3}) {
         EXPECT_NEAR(lin.U(h), h / 100e3, 1e-15);
-        EXPECT_NEAR(non.U(h), std::sqrt(h / 100e3), 1e-15);  // seed 000 2.4.2
+        EXPECT_NEAR(non.U(h), std::sqrt(h / 100e3), 1e-15);  // Boody's Atmosphere Plus notes 2.4.2
     }
     for (double c : {-1.0, -0.3, 0.0, 0.008, 0.7, 1.0}) {
         EXPECT_NEAR(lin.V(0.0, c), (c + 1.0) / 2.0, 1e-15);
         EXPECT_NEAR(lin.W(c), (c + 1.0) / 2.0, 1e-15);
-        // Seed 002's form of the same map: 0.5 (1 + sign(c) |c|^(1/3)).
+        // The earlier Atmosphere Plus notes (Boody)'s form of the same map: 0.5 (1 + sign(c)
+        // |c|^(1/3)).
         const double seed002 = 0.5 * (1.0 + (c < 0 ? -1.0 : 1.0) * std::cbrt(std::fabs(c)));
         EXPECT_NEAR(non.V(0.0, c), seed002, 1e-12);
         EXPECT_NEAR(non.W(c), seed002, 1e-12);
@@ -185,12 +186,13 @@ TEST(AtmospherePlus, PhaseFunctionsAreTheSeeds) {
     for (double c : {-1.0, -0.5, 0.0, 0.25, 1.0}) {
         EXPECT_NEAR(AplusRayleighPhase(c), 0.75 * (1 + c * c), 1e-15);
         EXPECT_NEAR(AplusModifiedRayleighPhase(c), 0.8 * (1.4 + 0.5 * c * c), 1e-15);
-        // Seed 000: 3(1-g^2)/(2(2+g^2)) (1+c^2)/(1+g^2-2gc)^1.5 with g = 0.8.
+        // Boody's Atmosphere Plus notes: 3(1-g^2)/(2(2+g^2)) (1+c^2)/(1+g^2-2gc)^1.5 with g = 0.8.
         const double g = 0.8;
         const double seed000 = 3 * (1 - g * g) / (2 * (2 + g * g)) * (1 + c * c) /
                                std::pow(1 + g * g - 2 * g * c, 1.5);
         EXPECT_NEAR(AplusMiePhase(g, c), seed000, 1e-12 * seed000);
-        // Seed 002 writes +2g cos with g = -0.85: the same lobe as g = +0.85 here.
+        // The earlier Atmosphere Plus notes (Boody) writes +2g cos with g = -0.85: the same lobe as
+        // g = +0.85 here.
         const double g2 = -0.85;
         const double seed002 = 3 * (1 - g2 * g2) / (2 * (2 + g2 * g2)) * (1 + c * c) /
                                std::pow(1 + g2 * g2 + 2 * g2 * c, 1.5);
@@ -199,7 +201,7 @@ TEST(AtmospherePlus, PhaseFunctionsAreTheSeeds) {
 }
 
 TEST(AtmospherePlus, PresetCarriesTheSeedsIncidentLight) {
-    // Seed 000 1.2: I_I = SpectralIrradiance x Exposure x SpectralToRGB.
+    // Boody's Atmosphere Plus notes 1.2: I_I = SpectralIrradiance x Exposure x SpectralToRGB.
     const AtmosphereParameters& atm = SeedAtmosphere();
     const double ii[3] = {0.1526 * 133.3209, 0.191 * 88.51855, 0.208 * 112.7552};
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(Channel(atm.solar_irradiance, c), ii[c], 1e-5);
@@ -218,10 +220,10 @@ double TrapezoidExp(double scale_height, double length, int n) {
 }
 
 TEST(AtmospherePlus, ZenithTransmittanceMatchesClosedForms) {
-    // Seed 000 (n = 30, the seed's value) and seed 002's constants (R_p 6371
-    // km, Rayleigh (6.55, 17.3, 23.0)e-6, Mie 2e-6 with extinction 2e-6/0.9):
-    // the table's texel at h = 0, mu = 1 holds exp(-trapezoid sum), which has a
-    // closed form for a vertical ray through exponential layers.
+    // Boody's Atmosphere Plus notes (n = 30, the seed's value) and the earlier Atmosphere Plus
+    // notes (Boody)'s constants (R_p 6371 km, Rayleigh (6.55, 17.3, 23.0)e-6, Mie 2e-6 with
+    // extinction 2e-6/0.9): the table's texel at h = 0, mu = 1 holds exp(-trapezoid sum), which has
+    // a closed form for a vertical ray through exponential layers.
     AtmosphereParameters seed002 = SeedAtmosphere();
     seed002.bottom_radius = 6371e3;
     seed002.top_radius = 6471e3;

@@ -17,8 +17,8 @@
 namespace atmos {
 namespace {
 
-// A local copy of seed 004's GetLayerDensity / GetProfileDensity (Bruneton 2017),
-// so the profiles are checked against the formula and not against our own code.
+// A local copy of Bruneton's 2017 implementation notes' GetLayerDensity / GetProfileDensity
+// (Bruneton 2017), so the profiles are checked against the formula and not against our own code.
 double LayerDensity(const DensityProfileLayer& layer, double altitude) {
     const double density = layer.exp_term * std::exp(layer.exp_scale * altitude) +
                            layer.linear_term * altitude + layer.constant_term;

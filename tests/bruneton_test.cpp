@@ -1,4 +1,4 @@
-// Tests of model `bruneton` (seed 004): tables against direct numerical
+// Tests of model `bruneton` (Bruneton's 2017 implementation notes): tables against direct numerical
 // integration, mappings, orders of scattering, rendering edge cases, storage
 // options and the bake.
 //
@@ -71,7 +71,7 @@ double Rel(double a, double b) { return std::fabs(a - b) / std::max(std::fabs(b)
 // ---------------------------------------------------------------------------
 
 TEST(Bruneton, TransmittanceTableMatchesNumericalIntegration) {
-    // Seed 004 default size (256 x 64); reference: trapezoid with 20000
+    // Bruneton's 2017 implementation notes default size (256 x 64); reference: trapezoid with 20000
     // intervals, independent of the table. (1) At texel centres (the stored
     // values: the precomputation's quadrature): relative error < 1e-3 where
     // T > 1e-3. (2) Between texels at random (r, mu) above the horizon
@@ -175,7 +175,7 @@ TEST(Bruneton, MappingsRoundTrip) {
 }
 
 TEST(Bruneton, TexelCentresHoldTheRangeEnds) {
-    // Seed 004: texel 0 and n-1 sample the ends of each range exactly.
+    // Bruneton's 2017 implementation notes: texel 0 and n-1 sample the ends of each range exactly.
     const BrunetonLut lut(EarthAtmosphere(), BrunetonConfig());
     double r, mu, mu_s, nu;
     bool ground;
@@ -448,7 +448,7 @@ TEST(Bruneton, RayMissingTheAtmosphereAndViewerInSpace) {
         EXPECT_EQ(r.transmittance.z, 1.0f);
     }
     // A viewer in space sees what a viewer on the top boundary, on the same
-    // ray, sees (seed 004: the viewer is moved to the top).
+    // ray, sees (Bruneton's 2017 implementation notes: the viewer is moved to the top).
     for (double mu : {-0.9, -0.7, -0.55}) {
         const Vec3d dir = Dir(mu);
         double t0, t1;
@@ -527,9 +527,9 @@ TEST(Bruneton, GroundIsLitOnlyWithAlbedo) {
 
 TEST(Bruneton, SkyIrradianceMatchesHemisphereIntegralOfSkyRadiance) {
     // The irradiance table (orders 1..N-1 of the sky on a horizontal surface,
-    // seed 004) against a numerical integral of the model's own sky radiance
-    // (orders 1..N) over the upper hemisphere, cosine-weighted: they differ by
-    // the last order (small) and the quadratures.
+    // Bruneton's 2017 implementation notes) against a numerical integral of the model's own sky
+    // radiance (orders 1..N) over the upper hemisphere, cosine-weighted: they differ by the last
+    // order (small) and the quadratures.
     const Precomputed p(EarthAtmosphere(), Small(4));
     const BrunetonLut& lut = p.eval.lut;
     for (double mu_s : {1.0, 0.5, 0.1}) {
@@ -560,9 +560,9 @@ TEST(Bruneton, SkyIrradianceMatchesHemisphereIntegralOfSkyRadiance) {
     }
 }
 
-// Seed 004 ComputeScatteringDensity for order 2, written as the seed has it (the
-// 16 x 32 direction grid around the view's azimuth, lookups per direction),
-// without ground albedo: the reference for the atmos rearrangement.
+// Bruneton's 2017 implementation notes ComputeScatteringDensity for order 2, written as the seed
+// has it (the 16 x 32 direction grid around the view's azimuth, lookups per direction), without
+// ground albedo: the reference for the atmos rearrangement.
 Rgb SeedDensityOrder2(const BrunetonLut& lut, const TableView& rayleigh, const TableView& mie,
                       double r, double mu, double mu_s, double nu) {
     const AtmosphereParameters& atm = lut.atm;

@@ -382,9 +382,9 @@ TEST(Camera, EquirectHasNoSeam) {
 
 // The diffuse horizontal irradiance integrated from an equirect map equals
 // bruneton's irradiance table (and the quadrature of its sample).
-// At orders=8: the table holds the irradiance of orders 1..N-1 only (seed 004
-// "Ground irradiance"), so at the default 4 orders it lacks the 4th order's
-// share (blue: 2.1 % at sun 30 degrees; 0.03 % at 8 orders).
+// At orders=8: the table holds the irradiance of orders 1..N-1 only (Bruneton's 2017 implementation
+// notes "Ground irradiance"), so at the default 4 orders it lacks the 4th order's share (blue: 2.1
+// % at sun 30 degrees; 0.03 % at 8 orders).
 TEST(Camera, HorizontalIrradianceFromTheMapMatchesBrunetonsTable) {
     const Model& m = Prepared("bruneton", {{"orders", "8"}});
     for (double elevation : {30.0, 5.0}) {

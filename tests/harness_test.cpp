@@ -99,7 +99,7 @@ TEST(Loc, FindsAModelsOwnFiles) {
     EXPECT_EQ(files[1], "src/atmos/models/naive.h");
     const ModelLoc loc = CountModelLoc(DefaultSourceDir(), "naive");
     EXPECT_GT(loc.lines, 20);
-    EXPECT_EQ(loc.thesis_lines, 118);  // seed 003 section 12.4
+    EXPECT_EQ(loc.thesis_lines, 118);  // Leenman's 2025 thesis section 12.4
     EXPECT_EQ(ThesisLoc("bruneton"), 832);
     EXPECT_EQ(ThesisLoc("no-such-model"), -1);
 }

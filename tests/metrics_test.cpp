@@ -254,7 +254,7 @@ TEST(Flip, HdrWithBlackPixelsIsFiniteAndCorrect) {
 }
 
 TEST(Flip, ThesisExposureSetupAddsOneNanoToEveryPixel) {
-    // `--exposure thesis` (seed 003 section 11.5): the same as HDR-FLIP of the
+    // `--exposure thesis` (Leenman's 2025 thesis section 11.5): the same as HDR-FLIP of the
     // images with 1e-9 added to every channel; with more than half of the
     // pixels black its median is ~1e-9, so the exposure range reaches ~30 stops
     // further than atmos's median over the non-black pixels, and the mean

@@ -216,7 +216,7 @@ NeuralEvaluator ShippedEvaluator(const char* network) {
 }
 
 TEST(Neural, ViewerOutsideTheAtmosphereIsMovedToItsBoundary) {
-    // Seed 003 section 9.6.3: a camera in space sees what a camera where the
+    // Leenman's 2025 thesis section 9.6.3: a camera in space sees what a camera where the
     // ray enters the atmosphere sees.
     const NeuralEvaluator e = ShippedEvaluator("thesis");
     const Vec3d sun = Normalize(Vec3d(0.3, 0.2, 1.0));

@@ -1,7 +1,7 @@
 // atmos: the parameters of a planet's atmosphere.
 //
-// Field names and the layered density profile follow seed 004 (Bruneton 2017,
-// "AtmosphereParameters" and "DensityProfileLayer"). All values are SI: metres,
+// Field names and the layered density profile follow Bruneton 2017,
+// "AtmosphereParameters" and "DensityProfileLayer". All values are SI: metres,
 // per-metre coefficients, radians. The struct is trivially copyable so that it
 // can be passed by value to device code.
 #pragma once
@@ -14,11 +14,11 @@
 
 namespace atmos {
 
-// One layer of a density profile (seed 004): the density at altitude h (metres
-// above bottom_radius) is
+// One layer of a density profile (Bruneton's 2017 implementation notes): the density at altitude h
+// (metres above bottom_radius) is
 //   clamp(exp_term * exp(exp_scale * h) + linear_term * h + constant_term, 0, 1)
-// Seed 004: layers[0] applies below layers[0].width (altitude from the ground),
-// layers[1] everywhere above.
+// Bruneton's 2017 implementation notes: layers[0] applies below layers[0].width (altitude from the
+// ground), layers[1] everywhere above.
 struct DensityProfileLayer {
     double width = 0.0;          // m; the last layer's width is ignored
     double exp_term = 0.0;       // dimensionless
@@ -27,7 +27,7 @@ struct DensityProfileLayer {
     double constant_term = 0.0;  // dimensionless
 };
 
-// Seed 004's two-layer profile: layers[0] applies below layers[0].width,
+// Bruneton's 2017 implementation notes' two-layer profile: layers[0] applies below layers[0].width,
 // layers[1] above. A single exponential uses layers[1] alone (layers[0] has
 // width 0).
 struct DensityProfile {

@@ -63,7 +63,7 @@ class Image {
     std::vector<float> pixels_;
 };
 
-// Display transform of DESIGN.md / seed 003 section 11.5 for PNG output:
+// Display transform of DESIGN.md / Leenman's 2025 thesis section 11.5 for PNG output:
 // multiply by `exposure`, tone map t(x) = 1 - exp(-x) per channel, then encode
 // with the sRGB transfer curve. Returns 8-bit values in [0, 255].
 unsigned char EncodeDisplayValue(float linear, float exposure);

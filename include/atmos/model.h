@@ -89,7 +89,7 @@ struct ModelInfo {
     std::vector<ModelOptionSpec> options;  // from the model's OptionTable (atmos/options.h)
     // `atmos loc` (harness/loc.h): the stem of its source files under
     // src/atmos/models/ (STEM.h, STEM.cpp, STEM_*.h ...; empty: the name with
-    // '-' as '_'), and the thesis's count of the same model (seed 003 section
+    // '-' as '_'), and the thesis's count of the same model (Leenman's 2025 thesis section
     // 12.4: its name there and its significant lines; -1: not in the thesis).
     std::string source_stem;
     std::string thesis_name;

@@ -1,4 +1,4 @@
-// atmos: cameras and the 12 named views of seed 003 section 11.4.
+// atmos: cameras and the 12 named views of Leenman's 2025 thesis section 11.4.
 //
 // The planet's centre is the origin and +z is the zenith of the reference
 // point on the ground (0, 0, bottom_radius). Cameras are pinhole cameras with a

@@ -3,7 +3,7 @@
 // A table holds `channels` (1..4) floats per texel, x fastest, then y, then z.
 // Sampling follows GPU texture conventions: coordinates in [0, 1] address the
 // whole table, texel i has its centre at (i + 0.5) / size, filtering is linear
-// and borders clamp to the edge texel. Seed 004's mapping helpers
+// and borders clamp to the edge texel. Bruneton's 2017 implementation notes' mapping helpers
 // (GetTextureCoordFromUnitRange and its inverse) map [0, 1] onto the texel
 // centres so that the first and last texels hold the range's end points.
 #pragma once
@@ -28,11 +28,11 @@ ATMOS_HD inline Vec4f operator*(const Vec4f& a, float s) {
     return {a.x * s, a.y * s, a.z * s, a.w * s};
 }
 
-// Seed 004: x in [0, 1] -> texture coordinate of the texel centres.
+// Bruneton's 2017 implementation notes: x in [0, 1] -> texture coordinate of the texel centres.
 ATMOS_HD inline double GetTextureCoordFromUnitRange(double x, int texture_size) {
     return 0.5 / texture_size + x * (1.0 - 1.0 / texture_size);
 }
-// Seed 004: the inverse.
+// Bruneton's 2017 implementation notes: the inverse.
 ATMOS_HD inline double GetUnitRangeFromTextureCoord(double u, int texture_size) {
     return (u - 0.5 / texture_size) / (1.0 - 1.0 / texture_size);
 }

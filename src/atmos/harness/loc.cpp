@@ -1,4 +1,4 @@
-// atmos: significant lines of code (seed 003 section 11.7; rules in loc.h).
+// atmos: significant lines of code (Leenman's 2025 thesis section 11.7; rules in loc.h).
 #include "harness/loc.h"
 
 #include <algorithm>
@@ -126,7 +126,7 @@ std::vector<std::string> ModelSourceFiles(const std::string& source_dir, const s
 }
 
 int ThesisLoc(const std::string& model, std::string* thesis_name) {
-    // Seed 003 section 12.4, "significant lines of code", as each model declares it.
+    // Leenman's 2025 thesis section 12.4, "significant lines of code", as each model declares it.
     const ModelInfo* info = RegisteredInfo(model);
     if (info == nullptr || info->thesis_lines < 0) return -1;
     if (thesis_name != nullptr) *thesis_name = info->thesis_name;

@@ -1,4 +1,4 @@
-// atmos: significant lines of code, by the rules of seed 003 section 11.7.
+// atmos: significant lines of code, by the rules of Leenman's 2025 thesis section 11.7.
 //
 // A line counts when it
 //   * is not empty (after removing comments and surrounding white space),
@@ -27,11 +27,12 @@ struct ModelLoc {
     std::string model;
     std::vector<std::string> files;  // relative to the source dir
     int lines = 0;
-    int thesis_lines = -1;  // seed 003 section 12.4, -1 when the thesis has no such model
+    int thesis_lines =
+        -1;  // Leenman's 2025 thesis section 12.4, -1 when the thesis has no such model
     std::string thesis_name;
 };
 ModelLoc CountModelLoc(const std::string& source_dir, const std::string& name);
-// The thesis's count for a model name (seed 003 section 12.4), or -1.
+// The thesis's count for a model name (Leenman's 2025 thesis section 12.4), or -1.
 int ThesisLoc(const std::string& model, std::string* thesis_name = nullptr);
 // The repository root: $ATMOS_SOURCE_DIR when set, else the one compiled into
 // the library (ATMOS_SOURCE_DIR).

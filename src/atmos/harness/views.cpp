@@ -1,4 +1,4 @@
-// atmos: the 12 views of seed 003 section 11.4 (numbers in docs/views.md).
+// atmos: the 12 views of Leenman's 2025 thesis section 11.4 (numbers in docs/views.md).
 #include <cmath>
 #include <string>
 #include <vector>

@@ -4,14 +4,15 @@
 // field names of AtmosphereParameters (SI units), plus optional "name" and
 // "description" strings. RGB fields take a number or an array of 3 numbers.
 // Density fields take one of
-//   {"layers": [LAYER] or [LAYER, LAYER]}   seed 004's DensityProfileLayer list; a
+//   {"layers": [LAYER] or [LAYER, LAYER]}   Bruneton's 2017 implementation notes'
+//   DensityProfileLayer list; a
 //       LAYER is an object with any of width, exp_term, exp_scale, linear_term,
 //       constant_term (missing ones are 0); one layer goes to layers[1] (the
 //       profile's layers[0] then has width 0 and never applies);
 //   {"scale_height": H}                      exp(-h / H);
 //   {"tent": {"center": c, "half_width": w}} 1 at c, falling linearly to 0 at c -/+ w.
-// Every field is required except mu_s_min (default cos(102 deg), seed 004's demo)
-// and the second Mie lobe's mie_phase_g2 and mie_phase_weight2 (default 0: one lobe).
+// Every field is required except mu_s_min (default cos(102 deg), Bruneton's 2017 implementation
+// notes' demo) and the second Mie lobe's mie_phase_g2 and mie_phase_weight2 (default 0: one lobe).
 // Unknown keys are errors (they are usually typos).
 #include <algorithm>
 #include <charconv>
@@ -61,7 +62,7 @@ const char kDensityForms[] =
     "a density is {\"layers\": [...]}, {\"scale_height\": H} or "
     "{\"tent\": {\"center\": c, \"half_width\": w}}";
 
-// Seed 004's demo: max_sun_zenith_angle = 102 degrees.
+// Bruneton's 2017 implementation notes' demo: max_sun_zenith_angle = 102 degrees.
 double DefaultMuSMin() { return std::cos(102.0 / 180.0 * kPi); }
 
 // The fields a file may leave out: mu_s_min (DefaultMuSMin) and the second
@@ -180,10 +181,9 @@ DensityProfile ReadDensity(const Json& node, const std::string& where, const std
         if (!(half_width > 0.0) || !std::isfinite(half_width)) {
             Fail(where, ": field '", path, ".tent.half_width' must be a finite number > 0 (m)");
         }
-        // Below the centre: (h - c + w) / w; above: (c + w - h) / w (seed 004's
-        // clamp to [0, 1] cuts both ends). The constant terms are written as one
-        // division each so that the canonical ozone layer (c = 25 km, w = 15 km)
-        // gives exactly -2/3 and 8/3.
+        // Below the centre: (h - c + w) / w; above: (c + w - h) / w (Bruneton's 2017 implementation
+        // notes' clamp to [0, 1] cuts both ends). The constant terms are written as one division
+        // each so that the canonical ozone layer (c = 25 km, w = 15 km) gives exactly -2/3 and 8/3.
         DensityProfile profile;
         profile.layers[0].width = center;
         profile.layers[0].linear_term = 1.0 / half_width;

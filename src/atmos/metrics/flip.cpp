@@ -491,7 +491,7 @@ const char* FlipExposureSetupName(FlipExposureSetup s) {
 FlipResult HdrFlip(const Image& reference, const Image& test, const FlipOptions& options) {
     CheckPair(reference, test);
     if (options.exposure_setup == FlipExposureSetup::kThesis) {
-        // Seed 003 section 11.5: 1e-9 added to every channel of every pixel.
+        // Leenman's 2025 thesis section 11.5: 1e-9 added to every channel of every pixel.
         auto offset = [](const Image& in) {
             Image out = in;
             float* d = out.data();

@@ -11,7 +11,7 @@
 // 3.2 divides by the reference's median luminance, which is 0 when at least
 // half of the pixels are black (e.g. the night side of the planet). The
 // reference tool then produces an infinite stop exposure and silently returns
-// a zero map (seed 003 section 11.5 had to add 1e-9 to every pixel). Here the
+// a zero map (Leenman's 2025 thesis section 11.5 had to add 1e-9 to every pixel). Here the
 // median is then taken over the pixels with positive luminance, and an image
 // with no positive pixel uses start = stop = 0. Images whose median is
 // positive are unaffected.
@@ -42,7 +42,7 @@ void CheckFlipPpd(double ppd);
 
 // HDR-FLIP's handling of black pixels (issue 15). kAtmos: the deviation
 // above (median over the positive luminances when the median is 0). kThesis:
-// seed 003 section 11.5, "a value of 1e-9 is added to the color channels of
+// Leenman's 2025 thesis section 11.5, "a value of 1e-9 is added to the color channels of
 // every pixel" of both images, then spec 3.2 unchanged (the median over all
 // pixels, which is about 1e-9 when half of them were black: many more
 // exposures, each brightening the dark part).

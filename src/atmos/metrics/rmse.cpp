@@ -1,4 +1,4 @@
-// atmos: RMSE and PSNR (seed 003 section 11.5, Eq. 61).
+// atmos: RMSE and PSNR (Leenman's 2025 thesis section 11.5, Eq. 61).
 #include "metrics/rmse.h"
 
 #include <cmath>

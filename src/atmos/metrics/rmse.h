@@ -1,10 +1,10 @@
 // atmos: root-mean-square error and PSNR between two images.
 //
-// Source: seed 003 section 11.5, Eq. 61: RMSE = sqrt(sum_i (v_model,i - v_ref,i)^2 / N),
-// applied per colour channel (N = pixels) and over all channels (N = 3 x pixels).
-// The per-pixel map stores |v_model - v_ref| per channel (the square root of
-// one squared sample), as the thesis's RMSE images. PSNR = 10 log10(peak^2 / MSE)
-// with MSE over all channels; +inf for identical images. Sums run in double.
+// Source: Leenman's 2025 thesis section 11.5, Eq. 61: RMSE = sqrt(sum_i (v_model,i - v_ref,i)^2 /
+// N), applied per colour channel (N = pixels) and over all channels (N = 3 x pixels). The per-pixel
+// map stores |v_model - v_ref| per channel (the square root of one squared sample), as the thesis's
+// RMSE images. PSNR = 10 log10(peak^2 / MSE) with MSE over all channels; +inf for identical images.
+// Sums run in double.
 #pragma once
 
 #include "atmos/image.h"

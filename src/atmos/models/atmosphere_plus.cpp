@@ -54,7 +54,7 @@ AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings
 
     const int64_t count = static_cast<int64_t>(s.width) * s.height * s.depth;
 
-    // Order 1 (seed 000 2.1).
+    // Order 1 (Boody's Atmosphere Plus notes 2.1).
     start = std::chrono::steady_clock::now();
     Table order(s.width, s.height, s.depth, 4);
     RunStage("atmosphere-plus/order-1", count, 16, AplusSingleScatteringStage{atm, s, order.out()});
@@ -63,8 +63,8 @@ AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings
     out.order_seconds.push_back(SecondsSince(start));
     if (keep_orders) out.orders.push_back(order);
 
-    // Orders 2..K (seed 000 2.2): gather from order k-1, order k, add to the sum.
-    // Each order's sum is recorded: orders that stop decreasing are reported
+    // Orders 2..K (Boody's Atmosphere Plus notes 2.2): gather from order k-1, order k, add to the
+    // sum. Each order's sum is recorded: orders that stop decreasing are reported
     // (models/order_check.h; orders >= 2 share their units).
     ScatteringOrders sums;
     sums.Add(1, TableSum(order));
@@ -94,7 +94,9 @@ ModelInfo AtmospherePlusModel::StaticInfo() {
     ModelInfo info;
     info.name = "atmosphere-plus";
     info.title = "Atmosphere Plus (3D table without azimuth)";
-    info.citation = "J. Boody, Atmosphere Plus notes: seed 000 sections 1.2-2.4 (seed 002 earlier)";
+    info.citation =
+        "J. Boody, Atmosphere Plus notes: Boody's Atmosphere Plus notes sections 1.2-2.4 (the "
+        "earlier Atmosphere Plus notes (Boody) earlier)";
     info.summary =
         "factored Rayleigh RGB + Mie alpha in a 3D table (h, view zenith, sun zenith), K orders "
         "by gathering; phase functions at render time";
@@ -131,7 +133,7 @@ const OptionTable<AplusSettings>& AtmospherePlusModel::OptionRows() {
                      {"nonlinear", P::kNonlinear},
                      {"power", P::kPower},
                      {"horizon", P::kHorizon}},
-                    "table mapping (seed 000 2.4)")
+                    "table mapping (Boody's Atmosphere Plus notes 2.4)")
             .ShapesTables()
             .Integer("table-width", &S::width, 2, 1024, "", "table size over altitude (u)")
             .ShapesTables()
@@ -181,7 +183,7 @@ const OptionTable<AplusSettings>& AtmospherePlusModel::OptionRows() {
             .Choice("rayleigh-phase", &S::modified_rayleigh,
                     {{"standard", false}, {"modified", true}},
                     "render-time Rayleigh phase: standard 3/4(1+c^2) or modified 0.8(1.4+0.5c^2) "
-                    "(seed 000 1.7)")
+                    "(Boody's Atmosphere Plus notes 1.7)")
             // Options that the chosen mapping ignores are errors, not silent no-ops.
             .Validate([](const std::string& model, const S& s, const std::set<std::string>& given) {
                 const P kind = s.mapping.kind;
@@ -287,7 +289,8 @@ void AtmospherePlusModel::Bake(const std::string& directory) const {
         {"file", "scattering.exr"},
         {"layout",
          "W*D x H pixels: D layers (sun zenith, w) side by side; x: altitude (u), "
-         "y: view zenith (v); texel i holds the value at i/(size-1) of seed 000 2.4"},
+         "y: view zenith (v); texel i holds the value at i/(size-1) of Boody's Atmosphere Plus "
+         "notes 2.4"},
         {"channels", "R, G, B: Rayleigh factored intensity; A: Mie (green channel)"}};
     j["transmittance"] = {{"file", "transmittance.exr"},
                           {"layout", "W x H: altitude (u) x view zenith (v), same mapping"}};

@@ -1,9 +1,9 @@
 // atmos model `atmosphere-plus`: the 3D-table model without azimuth.
 //
-// Source: J. Boody, "Atmosphere Plus" notes, seed 000 (sections 1.2-2.4); the
-// earlier version, seed 002, differs in constants only (R_p 6371 km, Rayleigh
-// (6.55, 17.3, 23.0)e-6 /m, Mie 2e-6 /m with extinction beta/0.9, g = -0.85 in a
-// Mie phase written with +2g cos) and states the same cube-root mapping.
+// Source: J. Boody, "Atmosphere Plus" notes, Boody's Atmosphere Plus notes (sections 1.2-2.4); the
+// earlier version, the earlier Atmosphere Plus notes (Boody), differs in constants only (R_p 6371
+// km, Rayleigh (6.55, 17.3, 23.0)e-6 /m, Mie 2e-6 /m with extinction beta/0.9, g = -0.85 in a Mie
+// phase written with +2g cos) and states the same cube-root mapping.
 //
 // Implements (factored form of section 2.3; Rayleigh in RGB, Mie in alpha):
 //   transmittance  T = exp(-t), t = trapezoidal rule (1.9) of the extinction
@@ -69,13 +69,16 @@
 
 namespace atmos {
 
-// Seed 000 section 1.7: phase functions normalised to 4 pi over the sphere.
+// Boody's Atmosphere Plus notes section 1.7: phase functions normalised to 4 pi over the sphere.
 ATMOS_HD inline double AplusRayleighPhase(double nu) { return 0.75 * (1.0 + nu * nu); }
 ATMOS_HD inline double AplusModifiedRayleighPhase(double nu) {
-    return 0.8 * (1.4 + 0.5 * nu * nu);  // seed 000 1.7 (integrates to 5.013 pi)
+    return 0.8 *
+           (1.4 + 0.5 * nu * nu);  // Boody's Atmosphere Plus notes 1.7 (integrates to 5.013 pi)
 }
 ATMOS_HD inline double AplusMiePhase(double g, double nu) {
-    return 4.0 * kPi * CornetteShanksPhase(g, nu);  // seed 000 1.7 = 4 pi x seed 003 Eq. 5
+    return 4.0 * kPi *
+           CornetteShanksPhase(
+               g, nu);  // Boody's Atmosphere Plus notes 1.7 = 4 pi x Leenman's 2025 thesis Eq. 5
 }
 // The atmosphere's Mie phase (one or two lobes, MiePhase) on the same scale.
 ATMOS_HD inline double AplusMiePhase(const AtmosphereParameters& atm, double nu) {
@@ -120,7 +123,7 @@ struct AplusThickNodes {
     }
 };
 
-// Seed 000 sections 1.10, 2.1, 2.3: the factored single scattering I1 for an
+// Boody's Atmosphere Plus notes sections 1.10, 2.1, 2.3: the factored single scattering I1 for an
 // observer at altitude h looking along mu with the sun at mu_s (azimuth 0),
 // trapezoidal rule with `steps` intervals along the view segment and
 // `sun_steps` along each sun ray.
@@ -171,7 +174,7 @@ ATMOS_HD inline AplusValue AplusSingleScattering(const AtmosphereParameters& atm
     return out;
 }
 
-// Seed 000 section 1.9: the 2D trapezoidal rule of f over [a, b] x [c, d] with
+// Boody's Atmosphere Plus notes section 1.9: the 2D trapezoidal rule of f over [a, b] x [c, d] with
 // n intervals in x and m in y (corner weight 1, edge 2, interior 4, times
 // dx dy / 4).
 template <typename T, typename F>
@@ -190,16 +193,17 @@ T AplusTrapezoid2D(const F& f, double a, double b, double c, double d, int n, in
 
 struct AplusSettings {
     AplusMapping mapping;  // default: horizon-centric (the lowest measured error)
-    int width = 32, height = 64, depth = 32;  // seed 000 2.4: (32, 256|128|64, 32)
+    int width = 32, height = 64,
+        depth = 32;  // Boody's Atmosphere Plus notes 2.4: (32, 256|128|64, 32)
     int transmittance_width = 64, transmittance_height = 256;
     // Numerics: the seed text gives n = 30 (1.10) only; K = 5 and the 6 x 12
     // gather (30 degree steps) are the constants of the seed author's solver
     // (atmosphere-plus repository, atmo_solver.c: ATMO_K, ATMO_GATHER_M/N_STEPS).
     int orders = 5;                  // K
-    int transmittance_steps = 30;    // seed 000 1.10: n = 30
+    int transmittance_steps = 30;    // Boody's Atmosphere Plus notes 1.10: n = 30
     int gather_theta = 12;           // 2D trapezoid intervals over Theta in [0, pi] (author's: 6)
     int gather_phi = 24;             // ... over Phi in [0, 2 pi] (author's: 12; issue 15)
-    bool modified_rayleigh = false;  // seed 000 1.7
+    bool modified_rayleigh = false;  // Boody's Atmosphere Plus notes 1.7
 };
 
 struct AplusTables {
@@ -354,7 +358,8 @@ struct AtmospherePlusEvaluator {
             }
             return out;
         }
-        // Seed 000 2.4: P_0 is the camera, or where the ray enters the atmosphere.
+        // Boody's Atmosphere Plus notes 2.4: P_0 is the camera, or where the ray enters the
+        // atmosphere.
         const Vec3d p0 = camera + dir * seg.t_start;
         const double r = Length(p0);
         const double h = Clamp(r - atm.bottom_radius, 0.0, atm.top_radius - atm.bottom_radius);
@@ -371,8 +376,8 @@ struct AtmospherePlusEvaluator {
         s.y = s4[1];
         s.z = s4[2];
         s.w = s4[3];
-        // Seed 000 2.3: I_S / I_I = F_R(dot(L, -V)) I_R + F_M(dot(L, -V)) I_M, with
-        // L = -sun and so dot(L, -V) = dot(sun, V) = nu.
+        // Boody's Atmosphere Plus notes 2.3: I_S / I_I = F_R(dot(L, -V)) I_R + F_M(dot(L, -V)) I_M,
+        // with L = -sun and so dot(L, -V) = dot(sun, V) = nu.
         const double f_r =
             modified_rayleigh ? AplusModifiedRayleighPhase(nu) : AplusRayleighPhase(nu);
         const double f_m = AplusMiePhase(atm, nu);

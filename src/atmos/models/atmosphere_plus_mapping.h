@@ -1,10 +1,11 @@
-// atmos model `atmosphere-plus`: the four texture parameterizations of seed 000
-// section 2.4 (altitude h, view-zenith cosine mu = cos(phi), sun-zenith cosine
-// mu_s = cos(delta)) <-> texture coordinates (u, v, w) in [0, 1].
+// atmos model `atmosphere-plus`: the four texture parameterizations of Boody's Atmosphere Plus
+// notes section 2.4 (altitude h, view-zenith cosine mu = cos(phi), sun-zenith cosine mu_s =
+// cos(delta)) <-> texture coordinates (u, v, w) in [0, 1].
 //
 //   linear     (2.4.1): u = h/H_a, v = (mu+1)/2, w = (mu_s+1)/2
 //   nonlinear  (2.4.2): u = sqrt(h/H_a), v, w = (sign(c)|c|^(1/3) + 1)/2
-//                       (seed 002 writes the same map as 0.5(1 + sign(c)|c|^(1/3)))
+//                       (the earlier Atmosphere Plus notes (Boody) writes the same map as 0.5(1 +
+//                       sign(c)|c|^(1/3)))
 //   power      (2.4.3): u = (h/H_a)^(1/p_u), v, w = (sign(c)|c|^(1/p)+1)/2
 //   horizon    (2.4.4): u as power; v split at the horizon cosine c_h:
 //                       sky:     v = (1 - s u)((mu - c_h)/(1 - c_h))^(1/p_a) + s u
@@ -36,7 +37,7 @@ ATMOS_HD inline double AplusPow(double x, double p) {
 ATMOS_HD inline double AplusRoot(double x, double p) {
     return p == 1.0 ? x : p == 2.0 ? Sqrt(x) : p == 3.0 ? cbrt(x) : Pow(x, 1.0 / p);
 }
-// sign(c) |c|^(1/p) -> maps [-1, 1] onto [-1, 1] (seed 000 2.4.3).
+// sign(c) |c|^(1/p) -> maps [-1, 1] onto [-1, 1] (Boody's Atmosphere Plus notes 2.4.3).
 ATMOS_HD inline double AplusSignedRoot(double c, double p) {
     const double a = AplusRoot(Abs(c), p);
     return c < 0.0 ? -a : a;
@@ -72,7 +73,7 @@ struct AplusMapping {
                                                            : p_w;
     }
 
-    // Seed 000 2.4.4: cosine of the horizon's view-zenith angle at altitude h.
+    // Boody's Atmosphere Plus notes 2.4.4: cosine of the horizon's view-zenith angle at altitude h.
     ATMOS_HD double HorizonCosine(double h) const {
         const double ratio = bottom_radius / (bottom_radius + Max(h, 0.0));
         if (horizon_angle == AplusHorizonAngle::kSeed) return -1.0 + ratio;

@@ -2,7 +2,7 @@
 // the one per-texel code of both backends (the CPU's ParallelFor and, in a
 // CUDA build, src/atmos/cuda/atmosphere_plus_stages.cu).
 //
-// Source and equations: atmosphere_plus.h (seed 000 sections 1.9-2.4). Stages,
+// Source and equations: atmosphere_plus.h (Boody's Atmosphere Plus notes sections 1.9-2.4). Stages,
 // each one texel per item (x fastest, then y, then z):
 //  * AplusTransmittanceStage: T(h, mu) of the view segment, trapezoidal rule (1.9, 1.10);
 //  * AplusSingleScatteringStage: order 1 (2.1, 2.3), AplusSingleScattering;
@@ -53,7 +53,7 @@ ATMOS_HD inline AplusTexel AplusTexelOf(int64_t i, const AplusSettings& s) {
     return t;
 }
 
-// Seed 000 sections 2.2, 2.3: the factored order k from the gather table of
+// Boody's Atmosphere Plus notes sections 2.2, 2.3: the factored order k from the gather table of
 // order k-1: beta/(4 pi) int G(P, V, L) p(h) T(P, P_a) ds, trapezoidal rule
 // with transmittance_steps intervals along the view segment.
 ATMOS_HD inline AplusValue AplusOrderFromGather(const TableView& gather,
@@ -100,7 +100,7 @@ ATMOS_HD inline AplusValue AplusOrderFromGather(const TableView& gather,
     return out;
 }
 
-// Seed 000 sections 1.9, 1.10: the transmittance table T(h, mu) of the view
+// Boody's Atmosphere Plus notes sections 1.9, 1.10: the transmittance table T(h, mu) of the view
 // segment (to the top of the atmosphere or to the ground), trapezoidal rule.
 // `out`: transmittance_width x transmittance_height x RGB.
 struct AplusTransmittanceStage {
@@ -131,7 +131,7 @@ struct AplusTransmittanceStage {
 };
 ATMOS_DEVICE_STAGE(AplusTransmittanceStage)
 
-// Order 1 (seed 000 2.1): AplusSingleScattering at every texel, n =
+// Order 1 (Boody's Atmosphere Plus notes 2.1): AplusSingleScattering at every texel, n =
 // transmittance_steps along the view and along each sun ray. `out`: the
 // scattering table's layout (width x height x depth x 4).
 struct AplusSingleScatteringStage {
@@ -158,7 +158,7 @@ ATMOS_DEVICE_STAGE(AplusSingleScatteringStage)
 // every node, with the same result.
 constexpr int kAplusGatherCachedThetas = 48;
 
-// Seed 000 2.2, 2.3: the factored gather G(P, V, L) = int_4pi F(dot(w, V))
+// Boody's Atmosphere Plus notes 2.2, 2.3: the factored gather G(P, V, L) = int_4pi F(dot(w, V))
 // I_prev(P, w, L) dw on the table's grid, by the 2D trapezoidal rule (1.9) over
 // Theta in [0, pi] (gather_theta intervals) and Phi in [0, 2 pi] (gather_phi),
 // dw = sin(Theta) dTheta dPhi. I_prev depends on w only through its zenith
@@ -211,7 +211,7 @@ struct AplusGatherStage {
 };
 ATMOS_DEVICE_STAGE(AplusGatherStage)
 
-// Order k (seed 000 2.2) from the gather table of order k-1.
+// Order k (Boody's Atmosphere Plus notes 2.2) from the gather table of order k-1.
 struct AplusOrderStage {
     AtmosphereParameters atm;
     AplusSettings s;

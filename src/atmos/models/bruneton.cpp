@@ -27,7 +27,8 @@ ModelInfo BrunetonModel::StaticInfo() {
     info.name = "bruneton";
     info.title = "Precomputed atmospheric scattering (Bruneton & Neyret 2008, Bruneton 2017)";
     info.citation =
-        "Bruneton & Neyret 2008; Bruneton 2017 (seed 004, functions.glsl); seed 003 sections "
+        "Bruneton & Neyret 2008; Bruneton 2017 (Bruneton's 2017 implementation notes, "
+        "functions.glsl); Leenman's 2025 thesis sections "
         "5.2, 11.2.3";
     info.summary =
         "4D scattering tables (packed 3D), transmittance and irradiance tables, N orders";
@@ -69,7 +70,7 @@ const OptionTable<BrunetonConfig>& BrunetonModel::OptionRows() {
             .ShapesTables()
             .Choice("scattering-rule", &C::scattering_rule, {{"simpson", 1}, {"trapezoid", 0}},
                     "quadrature along view rays: Simpson's rule, or the seed's trapezoid "
-                    "(scattering-rule=trapezoid reproduces seed 004)")
+                    "(scattering-rule=trapezoid reproduces Bruneton's 2017 implementation notes)")
             .ShapesTables()
             .Choice("mie-storage", &C::combined_mie, {{"separate", false}, {"combined", true}},
                     "single Mie scattering in its own table, or combined (red in the scattering "
@@ -212,7 +213,8 @@ void BrunetonModel::Bake(const std::string& directory) const {
     j["model"] = "bruneton";
     j["format_version"] = kBakeFormatVersion;
     j["description"] =
-        "Bruneton 2017 precomputed atmospheric scattering tables (seed 004 mappings), float32, "
+        "Bruneton 2017 precomputed atmospheric scattering tables (Bruneton's 2017 implementation "
+        "notes mappings), float32, "
         "per unit solar irradiance (multiply radiance and irradiance by solar_irradiance). Each "
         "table is one EXR of W*D x H pixels: the D layers side by side.";
     j["options"] = OptionsJson(OptionRows().Specs(), OptionRows().Values(config_));
@@ -243,7 +245,7 @@ void BrunetonModel::Bake(const std::string& directory) const {
                         ? "RGB: single Rayleigh + multiple scattering / RayleighPhase(nu); A: "
                           "single Mie red"
                         : "single Rayleigh + multiple scattering / RayleighPhase(nu)"},
-        {"mapping", "seed 004 GetScatteringTextureUvwzFromRMuMuSNu"}};
+        {"mapping", "Bruneton's 2017 implementation notes GetScatteringTextureUvwzFromRMuMuSNu"}};
     if (!config_.combined_mie) {
         tables["single_mie_scattering"] = {{"file", "single_mie_scattering.exr"},
                                            {"size",

@@ -1,10 +1,10 @@
 // atmos model `bruneton`: precomputed atmospheric scattering (Bruneton & Neyret
-// 2008, in the 2017 reimplementation documented by seed 004).
+// 2008, in the 2017 reimplementation documented by Bruneton's 2017 implementation notes).
 //
-// Source: seed 004 (Bruneton 2017, functions.glsl: every section), seed 003
+// Source: Bruneton 2017, functions.glsl: every section, Leenman's 2025 thesis
 // sections 5.2 and 11.2.3 (the thesis used this implementation with 4 orders).
 //
-// Implements (seed 004 section named in each function's comment):
+// Implements (Bruneton's 2017 implementation notes section named in each function's comment):
 //   * transmittance to the top of the atmosphere T(r, mu) in a 2D table (256x64)
 //     with the generic (r, mu) mapping and texel-centre coordinates;
 //   * direct ground irradiance (64x16) and, per order, indirect irradiance;
@@ -16,7 +16,7 @@
 //     the atmosphere: L = 0, T = 1), GetSkyRadianceToPoint (aerial perspective),
 //     GetSunAndSkyIrradiance (lit ground); light shafts via shadow_length.
 //   Mie storage: its own table (default) or combined (red in the alpha channel of
-//   the scattering table, green and blue extrapolated, seed 004
+//   the scattering table, green and blue extrapolated, Bruneton's 2017 implementation notes
 //   GetExtrapolatedSingleMieScattering).
 //   The precomputation's steps are stage structs (models/bruneton_stages.h)
 //   that RunStage runs on the CPU or, on the CUDA backend, on the device.
@@ -54,7 +54,7 @@
 
 namespace atmos {
 
-// Table sizes and precomputation options (defaults: seed 004).
+// Table sizes and precomputation options (defaults: Bruneton's 2017 implementation notes).
 struct BrunetonConfig {
     int transmittance_width = 256;  // mu
     int transmittance_height = 64;  // r
@@ -64,11 +64,12 @@ struct BrunetonConfig {
     int scattering_mu = 128;  // even: half for rays hitting the ground
     int scattering_mu_s = 32;
     int scattering_nu = 8;
-    int orders = 4;                // scattering orders (1 = single scattering only)
-    int scattering_samples = 100;  // intervals along view rays (seed 004: 50)
+    int orders = 4;  // scattering orders (1 = single scattering only)
+    int scattering_samples =
+        100;  // intervals along view rays (Bruneton's 2017 implementation notes: 50)
     // Quadrature along view rays in single and multiple scattering: Simpson's
     // rule (default, issue 15) or the seed's trapezoid.
-    int scattering_rule = 1;    // 0: trapezoid (seed 004), 1: Simpson
+    int scattering_rule = 1;    // 0: trapezoid (Bruneton's 2017 implementation notes), 1: Simpson
     bool combined_mie = false;  // Mie red in the scattering table's alpha
     // Single Mie scattering of rays to the ground (aerial perspective) with the
     // sun low (mu_s < 0.01): 0: integrated along the segment (default), 1: the
@@ -172,10 +173,10 @@ ATMOS_HD inline void BrunetonSample4D(const float* data, const Bruneton4DRows& r
     }
 }
 
-// The lookup functions of seed 004 over a set of tables (trivially copyable;
-// used both by the precomputation, over its intermediate tables, and by the
-// renderer, over the final ones). Every function is ATMOS_HD. Construct it
-// from (atmosphere, config): the constructor computes `k`.
+// The lookup functions of Bruneton's 2017 implementation notes over a set of tables (trivially
+// copyable; used both by the precomputation, over its intermediate tables, and by the renderer,
+// over the final ones). Every function is ATMOS_HD. Construct it from (atmosphere, config): the
+// constructor computes `k`.
 struct BrunetonLut {
     AtmosphereParameters atm;
     BrunetonConfig cfg;
@@ -217,7 +218,7 @@ struct BrunetonLut {
         v(single_mie_table);
     }
 
-    // ---- helpers (seed 004, "ClampRadius", distances) ----
+    // ---- helpers (Bruneton's 2017 implementation notes, "ClampRadius", distances) ----
     ATMOS_HD double ClampRadius(double r) const {
         return Clamp(r, atm.bottom_radius, atm.top_radius);
     }
@@ -225,7 +226,7 @@ struct BrunetonLut {
     ATMOS_HD double HorizonH() const {
         return Sqrt(atm.top_radius * atm.top_radius - atm.bottom_radius * atm.bottom_radius);
     }
-    // Seed 004 "DistanceToNearestAtmosphereBoundary".
+    // Bruneton's 2017 implementation notes "DistanceToNearestAtmosphereBoundary".
     ATMOS_HD double DistanceToNearestAtmosphereBoundary(double r, double mu,
                                                         bool ray_r_mu_intersects_ground) const {
         return ray_r_mu_intersects_ground
@@ -233,8 +234,8 @@ struct BrunetonLut {
                    : DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius);
     }
 
-    // ---- transmittance (seed 004, "Precomputation" / "Lookup" of transmittance) ----
-    // GetTransmittanceTextureUvFromRMu, with the constants of k.
+    // ---- transmittance (Bruneton's 2017 implementation notes, "Precomputation" / "Lookup" of
+    // transmittance) ---- GetTransmittanceTextureUvFromRMu, with the constants of k.
     ATMOS_HD void TransmittanceUvFromRMu(double r, double mu, double* u, double* v) const {
         ATMOS_DASSERT(k.H > 0.0);
         const double rho = SafeSqrt(r * r - k.bottom2);
@@ -285,8 +286,8 @@ struct BrunetonLut {
         return transmittance_table.SampleBilinear(u, v).rgb();
     }
     // GetTransmittance between (r, mu) and the point at distance d along the ray;
-    // the caller says whether the ray (r, mu) hits the ground (seed 004: not
-    // recomputed here, because rounding makes that test unreliable at the horizon).
+    // the caller says whether the ray (r, mu) hits the ground (Bruneton's 2017 implementation
+    // notes: not recomputed here, because rounding makes that test unreliable at the horizon).
     ATMOS_HD Rgb Transmittance(double r, double mu, double d,
                                bool ray_r_mu_intersects_ground) const {
         const double r_d = ClampRadius(Sqrt(d * d + 2.0 * r * mu * d + r * r));
@@ -300,7 +301,7 @@ struct BrunetonLut {
         return SafeRatio(t);
     }
     // GetTransmittanceToSun: the visible fraction of the sun's disc above the
-    // horizon as a smoothstep (seed 004, "Transmittance to the Sun").
+    // horizon as a smoothstep (Bruneton's 2017 implementation notes, "Transmittance to the Sun").
     ATMOS_HD Rgb TransmittanceToSun(double r, double mu_s) const {
         const double sin_theta_h = atm.bottom_radius / r;
         const double cos_theta_h = -SafeSqrt(1.0 - sin_theta_h * sin_theta_h);
@@ -310,8 +311,9 @@ struct BrunetonLut {
         return TransmittanceToTop(r, mu_s) * static_cast<float>(f);
     }
 
-    // ---- scattering table mapping (seed 004, "Precomputation" of single scattering) ----
-    // The mu_s part of GetScatteringTextureUvwzFromRMuMuSNu (constants of k).
+    // ---- scattering table mapping (Bruneton's 2017 implementation notes, "Precomputation" of
+    // single scattering) ---- The mu_s part of GetScatteringTextureUvwzFromRMuMuSNu (constants of
+    // k).
     ATMOS_HD double ScatteringUMuS(double mu_s) const { return BrunetonUMuS(k, mu_s); }
     // The (mu, r) part: v = u_mu, w = u_r (constants of k).
     ATMOS_HD void ScatteringUMuR(double r, double mu, bool ray_r_mu_intersects_ground, double* u_mu,
@@ -443,8 +445,8 @@ struct BrunetonLut {
         return Clamp(nu, mu * mu_s - s, mu * mu_s + s);
     }
 
-    // 4D lookup as two 3D lookups (seed 004 GetScattering), from the mapped
-    // coordinates; quadrilinear interpolation.
+    // 4D lookup as two 3D lookups (Bruneton's 2017 implementation notes GetScattering), from the
+    // mapped coordinates; quadrilinear interpolation.
     ATMOS_HD static Vec4f Lookup4D(const TableView& table, int nu_size, const double uvwz[4]) {
         const double tex_coord_x = uvwz[0] * (nu_size - 1);
         const double tex_x = floor(tex_coord_x);
@@ -484,16 +486,16 @@ struct BrunetonLut {
         return v;
     }
 
-    // Seed 004 GetExtrapolatedSingleMieScattering (combined storage).
+    // Bruneton's 2017 implementation notes GetExtrapolatedSingleMieScattering (combined storage).
     ATMOS_HD Rgb ExtrapolatedSingleMie(const Vec4f& s) const {
         if (s.x <= 0.0f) return Rgb(0.0f);
         const Vec3d ratio = atm.mie_scattering / atm.rayleigh_scattering *
                             (atm.rayleigh_scattering.x / atm.mie_scattering.x);
         return s.rgb() * (s.w / s.x) * Rgb(ratio);
     }
-    // Seed 004 GetCombinedScattering: Rayleigh + multiple scattering, and the
-    // single Mie scattering (without phase functions). One split for both
-    // tables, fixed-layout lookups.
+    // Bruneton's 2017 implementation notes GetCombinedScattering: Rayleigh + multiple scattering,
+    // and the single Mie scattering (without phase functions). One split for both tables,
+    // fixed-layout lookups.
     ATMOS_HD Rgb CombinedScattering(double r, double mu, double mu_s, double nu,
                                     bool ray_r_mu_intersects_ground, Rgb* single_mie) const {
         double uvwz[4];
@@ -535,7 +537,7 @@ struct BrunetonLut {
         return s.rgb();
     }
 
-    // ---- irradiance (seed 004, "Ground irradiance") ----
+    // ---- irradiance (Bruneton's 2017 implementation notes, "Ground irradiance") ----
     ATMOS_HD void IrradianceUvFromRMuS(double r, double mu_s, double* u, double* v) const {
         ATMOS_DASSERT(k.H > 0.0);
         const double x_r = (r - k.bottom) / k.irradiance_r_range;
@@ -567,8 +569,8 @@ struct BrunetonLut {
         IrradianceUvFromRMuSGeneric(ClampRadius(r), ClampCosine(mu_s), &u, &v);
         return table.SampleBilinear(u, v).rgb();
     }
-    // Seed 004 ComputeDirectIrradiance (per unit solar irradiance): the average
-    // cosine over the visible part of the sun's disc times T to the top.
+    // Bruneton's 2017 implementation notes ComputeDirectIrradiance (per unit solar irradiance): the
+    // average cosine over the visible part of the sun's disc times T to the top.
     ATMOS_HD Rgb DirectIrradiance(double r, double mu_s) const {
         const double alpha_s = atm.sun_angular_radius;
         const double c =
@@ -578,7 +580,7 @@ struct BrunetonLut {
         return TransmittanceToTop(r, mu_s) * static_cast<float>(c);
     }
 
-    // ---- rendering (seed 004, "Rendering") ----
+    // ---- rendering (Bruneton's 2017 implementation notes, "Rendering") ----
     // GetSkyRadiance, per unit solar irradiance. `ray_hits_ground` is the
     // caller's (robust) answer to "does the view ray meet the ground".
     ATMOS_HD Rgb SkyRadiance(Vec3d camera, const Vec3d& view_ray, double shadow_length,
@@ -607,7 +609,8 @@ struct BrunetonLut {
         if (shadow_length == 0.0) {
             scattering = CombinedScattering(r, mu, mu_s, nu, ray_hits_ground, &single_mie);
         } else {
-            // Light shafts (seed 004; paper Eq. 18): omit the first l metres.
+            // Light shafts (Bruneton's 2017 implementation notes; paper Eq. 18): omit the first l
+            // metres.
             const double d = shadow_length;
             const double r_p = ClampRadius(Sqrt(d * d + 2.0 * r * mu * d + r * r));
             const double mu_p = (r * mu + d) / r_p;
@@ -664,12 +667,11 @@ struct BrunetonLut {
             s.w = single_mie.x;
             single_mie = ExtrapolatedSingleMie(s);
         }
-        // Seed 004 fades single Mie out below mu_s = 0.01 ("hack to avoid
-        // rendering artifacts when the sun is below the horizon": the two
-        // lookups' interpolation errors do not cancel in the difference, and
-        // the Mie phase's forward peak magnifies them). That fade also removes
-        // the real sunset glow over the ground (issue 15), so by default the
-        // faded part is replaced by the single Mie integral along the segment
+        // Bruneton's 2017 implementation notes fades single Mie out below mu_s = 0.01 ("hack to
+        // avoid rendering artifacts when the sun is below the horizon": the two lookups'
+        // interpolation errors do not cancel in the difference, and the Mie phase's forward peak
+        // magnifies them). That fade also removes the real sunset glow over the ground (issue 15),
+        // so by default the faded part is replaced by the single Mie integral along the segment
         // itself (to the point, or shadow_length before it), which has no
         // difference to go wrong.
         const double fade = SmoothStep(0.0, 0.01, mu_s);
@@ -786,7 +788,7 @@ struct BrunetonTables {
 using BrunetonOrderCallback =
     std::function<void(int order, const BrunetonTables& tables, const Table* density)>;
 
-// The whole precomputation of seed 004, stage by stage through RunStage
+// The whole precomputation of Bruneton's 2017 implementation notes, stage by stage through RunStage
 // (models/bruneton_stages.h): on the CPU (ParallelFor) or, on the CUDA backend,
 // on the device. Tables are per unit solar irradiance. Throws atmos::Error for
 // an invalid configuration. Each stage's time is in the stage log
@@ -815,7 +817,8 @@ class BrunetonModel : public EvaluatorModel<BrunetonModel> {
     void Bake(const std::string& directory) const override;
     int64_t TableBytes() const override;
     void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere) override;
-    // The irradiance table (seed 004 "Ground irradiance": indirect only).
+    // The irradiance table (Bruneton's 2017 implementation notes "Ground irradiance": indirect
+    // only).
     bool TableSkyIrradiance(double altitude_m, double mu_s, Rgb* out) const override;
 
     const BrunetonConfig& config() const { return config_; }

@@ -1,5 +1,5 @@
-// atmos model `bruneton`: the precomputation (seed 004, every "Precomputation"
-// section, and the order loop of Bruneton's model: transmittance, direct
+// atmos model `bruneton`: the precomputation (Bruneton's 2017 implementation notes, every
+// "Precomputation" section, and the order loop of Bruneton's model: transmittance, direct
 // irradiance, single scattering, then per order n >= 2 the scattering density,
 // the indirect irradiance of order n - 1 and the multiple scattering of order n).
 // Every stage runs through RunStage (render/stages.h: the CPU's ParallelFor or
@@ -453,7 +453,7 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
     RunStage("bruneton direct irradiance", TexelCount(delta_irradiance), config.irradiance_width,
              BrunetonDirectIrradianceStage{lut, delta_irradiance.out()});
     // The irradiance table holds the indirect irradiance only (the direct one is
-    // computed at render time from the transmittance, seed 004).
+    // computed at render time from the transmittance, Bruneton's 2017 implementation notes).
     tables->irradiance.Resize(config.irradiance_width, config.irradiance_height, 1, 3);
 
     Table delta_rayleigh, delta_mie;
@@ -548,7 +548,7 @@ void PrecomputeBrunetonWith(const AtmosphereParameters& atmosphere, const Brunet
         session.Download(&delta_multiple);
         sums.Add(order, TableSum(delta_multiple));
         // Accumulate, divided by the Rayleigh phase function (the renderer
-        // multiplies the whole table by it; seed 004 "Rendering").
+        // multiplies the whole table by it; Bruneton's 2017 implementation notes "Rendering").
         RunStage(
             "bruneton accumulate", TexelCount(delta_multiple), width,
             BrunetonAccumulateStage{mappings, delta_multiple.view(), tables->scattering.out(true)});

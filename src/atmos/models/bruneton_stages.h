@@ -1,10 +1,10 @@
 // atmos model `bruneton`: the precomputation's stages (render/stages.h), one
-// struct per stage of seed 004's precomputation, each doing one texel (or, for
-// the incident radiance of the scattering density, one direction) per item, so
-// that the CPU (ParallelFor) and the device (one thread per item,
-// src/atmos/cuda/bruneton_stages.cu) run the same code.
+// struct per stage of Bruneton's 2017 implementation notes' precomputation, each doing one texel
+// (or, for the incident radiance of the scattering density, one direction) per item, so that the
+// CPU (ParallelFor) and the device (one thread per item, src/atmos/cuda/bruneton_stages.cu) run the
+// same code.
 //
-// Source: seed 004 (Bruneton 2017, functions.glsl), every "Precomputation"
+// Source: Bruneton 2017, functions.glsl, every "Precomputation"
 // section; the functions each stage implements are named in its comment.
 //
 // Two stages have a faster CPU form that shares per-row work in std::vectors
@@ -25,7 +25,7 @@
 
 namespace atmos {
 
-// Seed 004: the number of intervals of each numerical integral.
+// Bruneton's 2017 implementation notes: the number of intervals of each numerical integral.
 constexpr int kBrunetonTransmittanceSamples = 500;  // ComputeOpticalLengthToTopAtmosphereBoundary
 constexpr int kBrunetonDensityThetaSamples = 16;    // ComputeScatteringDensity: SAMPLE_COUNT
 constexpr int kBrunetonIrradianceSamples = 32;      // ComputeIndirectIrradiance: SAMPLE_COUNT
@@ -45,7 +45,7 @@ ATMOS_HD inline void BrunetonTexelOf(int64_t item, int width, int height, int* x
 
 // The opening of the per-texel stages of the scattering tables: the texel of
 // `item` in a `width` x `height` x depth table and the (r, mu, mu_s, nu) it
-// stands for, with whether its view ray hits the ground (seed 004
+// stands for, with whether its view ray hits the ground (Bruneton's 2017 implementation notes
 // GetRMuMuSNuFromScatteringTextureFragCoord).
 struct BrunetonScatteringTexel {
     int x, y, z;
@@ -81,8 +81,9 @@ inline BrunetonLut BrunetonMappingsOnly(const BrunetonLut& lut) {
     return BrunetonLut(lut.atm, lut.cfg);
 }
 
-// ---- transmittance (seed 004 ComputeTransmittanceToTopAtmosphereBoundaryTexture) ----
-// Item: texel x + W * y of the W x H table (3 channels).
+// ---- transmittance (Bruneton's 2017 implementation notes
+// ComputeTransmittanceToTopAtmosphereBoundaryTexture) ---- Item: texel x + W * y of the W x H table
+// (3 channels).
 struct BrunetonTransmittanceStage {
     BrunetonLut lut;  // mappings only
     TableOut out;
@@ -103,7 +104,7 @@ struct BrunetonTransmittanceStage {
 };
 ATMOS_DEVICE_STAGE(BrunetonTransmittanceStage)
 
-// ---- direct irradiance (seed 004 ComputeDirectIrradianceTexture) ----
+// ---- direct irradiance (Bruneton's 2017 implementation notes ComputeDirectIrradianceTexture) ----
 // Item: texel of the irradiance table; reads the transmittance table.
 struct BrunetonDirectIrradianceStage {
     BrunetonLut lut;  // with the transmittance table
@@ -123,15 +124,14 @@ struct BrunetonDirectIrradianceStage {
 };
 ATMOS_DEVICE_STAGE(BrunetonDirectIrradianceStage)
 
-// ---- single scattering (seed 004 ComputeSingleScattering(Texture)) ----
-// Sample i of n along the view ray (r, mu): what does not depend on (mu_s, nu),
-// i.e. what one (r, mu) row of the table shares: the distance d_i, the radius
-// r_i, and the transmittance from the camera times the Rayleigh and Mie
-// densities and the trapezoid weight (seed 004 ComputeSingleScatteringIntegrand
-// and the sum of ComputeSingleScattering). On a ray with optically thick steps
-// (RayHasThickSteps) `thick` is the node's ThickRayWeights factor W_i /
-// sigma_t,i instead (physics/exp_quadrature.h: the seed's rule is not energy
-// conserving there).
+// ---- single scattering (Bruneton's 2017 implementation notes ComputeSingleScattering(Texture))
+// ---- Sample i of n along the view ray (r, mu): what does not depend on (mu_s, nu), i.e. what one
+// (r, mu) row of the table shares: the distance d_i, the radius r_i, and the transmittance from the
+// camera times the Rayleigh and Mie densities and the trapezoid weight (Bruneton's 2017
+// implementation notes ComputeSingleScatteringIntegrand and the sum of ComputeSingleScattering). On
+// a ray with optically thick steps (RayHasThickSteps) `thick` is the node's ThickRayWeights factor
+// W_i / sigma_t,i instead (physics/exp_quadrature.h: the seed's rule is not energy conserving
+// there).
 struct BrunetonSingleSample {
     double d, r;
     Rgb t_rayleigh, t_mie;
@@ -201,7 +201,7 @@ struct BrunetonSingleScatteringStage {
 ATMOS_DEVICE_STAGE(BrunetonSingleScatteringStage)
 
 // The scattering table after order 1: single Rayleigh (and, with combined
-// storage, single Mie red in alpha, seed 004 "Precomputation" of the
+// storage, single Mie red in alpha, Bruneton's 2017 implementation notes "Precomputation" of the
 // scattering texture); with separate storage the single Mie table is a copy of
 // the single Mie scattering. Item: texel.
 struct BrunetonCombineStage {
@@ -234,9 +234,9 @@ struct BrunetonCombineStage {
 };
 ATMOS_DEVICE_STAGE(BrunetonCombineStage)
 
-// ---- scattering density J_n (seed 004 ComputeScatteringDensity(Texture)) ----
-// The fixed grid of incident directions (16 theta x 32 phi midpoints) in a frame
-// whose x axis is the sun's azimuth, as one table: 1 channel, width 4 * 512:
+// ---- scattering density J_n (Bruneton's 2017 implementation notes
+// ComputeScatteringDensity(Texture)) ---- The fixed grid of incident directions (16 theta x 32 phi
+// midpoints) in a frame whose x axis is the sun's azimuth, as one table: 1 channel, width 4 * 512:
 // x, y, z of each direction, then its solid angle (float), structure of arrays
 // (MakeBrunetonDirectionTable, built once on the host).
 struct BrunetonDirections {
@@ -322,9 +322,9 @@ ATMOS_DEVICE_STAGE(BrunetonIncidentStage)
 
 // Sum over the directions of L_i d omega times the Rayleigh and Mie phase
 // functions without their constant factors (1 + x^2 and (1 + x^2) / den^1.5;
-// seed 004 ComputeScatteringDensity, the inner sum), for the view direction
-// (ox, oy, oz) in the sun's frame. `l` points to the 3 * 512 floats of one
-// (r, mu_s) pair of the incident table.
+// Bruneton's 2017 implementation notes ComputeScatteringDensity, the inner sum), for the view
+// direction (ox, oy, oz) in the sun's frame. `l` points to the 3 * 512 floats of one (r, mu_s) pair
+// of the incident table.
 ATMOS_HD inline void BrunetonPhaseSums(const BrunetonDirections& grid, const float* l, float ox,
                                        float oy, float oz, float g, Rgb* sum_rayleigh,
                                        Rgb* sum_mie) {
@@ -422,9 +422,9 @@ struct BrunetonDensityStage {
 };
 ATMOS_DEVICE_STAGE(BrunetonDensityStage)
 
-// ---- indirect irradiance of order n (seed 004 ComputeIndirectIrradiance(Texture)) ----
-// Item: texel of the irradiance table; `order` is n (1: from the single
-// scattering tables, else from the multiple scattering of order n).
+// ---- indirect irradiance of order n (Bruneton's 2017 implementation notes
+// ComputeIndirectIrradiance(Texture)) ---- Item: texel of the irradiance table; `order` is n (1:
+// from the single scattering tables, else from the multiple scattering of order n).
 struct BrunetonIndirectIrradianceStage {
     BrunetonLut lut;  // mappings only
     TableView single_rayleigh, single_mie, multiple;
@@ -491,10 +491,10 @@ struct BrunetonAddStage {
 };
 ATMOS_DEVICE_STAGE(BrunetonAddStage)
 
-// ---- multiple scattering of order n (seed 004 ComputeMultipleScattering(Texture)) ----
-// The density J_n's 4D lookup: the renderer's (BrunetonLut::CombinedScattering:
-// BrunetonSplitRows, BrunetonSplitColumns, BrunetonSample4D and BrunetonUMuS),
-// in its two parts so that a row of texels shares the (mu, r) rows.
+// ---- multiple scattering of order n (Bruneton's 2017 implementation notes
+// ComputeMultipleScattering(Texture)) ---- The density J_n's 4D lookup: the renderer's
+// (BrunetonLut::CombinedScattering: BrunetonSplitRows, BrunetonSplitColumns, BrunetonSample4D and
+// BrunetonUMuS), in its two parts so that a row of texels shares the (mu, r) rows.
 struct BrunetonFastLookup {
     const float* data;
     int width, height, depth, nu_size;
@@ -520,10 +520,10 @@ struct BrunetonFastLookup {
 };
 
 // Sample i of n along the view ray (r, mu) of the multiple scattering integral
-// (seed 004 ComputeMultipleScattering): what one (r, mu) row shares: distance,
-// radius, the (mu, r) rows of the density lookup, and the transmittance from
-// the camera times the trapezoid weight and dx (on a ray with optically thick
-// steps: `thick`, the node's W_i / sigma_t,i, as for single scattering).
+// (Bruneton's 2017 implementation notes ComputeMultipleScattering): what one (r, mu) row shares:
+// distance, radius, the (mu, r) rows of the density lookup, and the transmittance from the camera
+// times the trapezoid weight and dx (on a ray with optically thick steps: `thick`, the node's W_i /
+// sigma_t,i, as for single scattering).
 struct BrunetonMultipleSample {
     double d, r, inv_r;
     BrunetonFastLookup::Rows rows;
@@ -599,7 +599,8 @@ struct BrunetonMultipleScatteringStage {
 ATMOS_DEVICE_STAGE(BrunetonMultipleScatteringStage)
 
 // scattering += delta_multiple / RayleighPhase(nu): the renderer multiplies the
-// whole table by the Rayleigh phase function (seed 004 "Rendering"). Item: texel.
+// whole table by the Rayleigh phase function (Bruneton's 2017 implementation notes "Rendering").
+// Item: texel.
 struct BrunetonAccumulateStage {
     BrunetonLut lut;  // mappings only
     TableView delta;

@@ -1,6 +1,6 @@
 // atmos model `empty`: a constant white sky.
 //
-// Source: seed 003 section 11.2.1 (the "empty shader"): it does no physics and
+// Source: Leenman's 2025 thesis section 11.2.1 (the "empty shader"): it does no physics and
 // measures the overhead of the render loop itself. Output: sky radiance 1 per
 // unit solar irradiance for every ray (so a render shows the view's irradiance),
 // transmittance 1. Valid: it is not a model of anything; it is a baseline.

@@ -1,7 +1,7 @@
 // atmos model `flat`: single scattering in one segment of a homogeneous-sphere
 // atmosphere (the thesis's "flat" model).
 //
-// Source: seed 003 section 10 (Eq. 45-55, 59) and section 11.2.9, after Jodie
+// Source: Leenman's 2025 thesis section 10 (Eq. 45-55, 59) and section 11.2.9, after Jodie
 // 2019 and Rapp-Arraras & Domingo-Santos 2011 (Eq. 49, "DR-1").
 //
 // Implements: each medium's optical length along a ray from radius r with

@@ -36,7 +36,8 @@ ModelInfo HillaireModel::StaticInfo() {
     info.title = "Hillaire 2020 (sky-view, aerial perspective, multiple-scattering LUTs)";
     info.citation =
         "Hillaire 2020, A Scalable and Production Ready Sky and Atmosphere Rendering Technique "
-        "(EGSR); seed 003 sections 5.2, 11.2.4, 12.1.1; seed 004 transmittance mapping";
+        "(EGSR); Leenman's 2025 thesis sections 5.2, 11.2.4, 12.1.1; Bruneton's 2017 "
+        "implementation notes transmittance mapping";
     info.summary =
         "transmittance + multiple-scattering LUTs; per-frame sky-view and aerial-perspective "
         "tables inside the atmosphere, ray march outside";
@@ -136,9 +137,9 @@ HillaireEvaluator HillaireModel::StageEvaluator() const {
     return e;
 }
 
-// Transmittance table: seed 004 ComputeTransmittanceToTopAtmosphereBoundaryTexture,
-// optical depth by the midpoint rule with transmittance_steps_ segments
-// (HillaireTransmittanceStage).
+// Transmittance table: Bruneton's 2017 implementation notes
+// ComputeTransmittanceToTopAtmosphereBoundaryTexture, optical depth by the midpoint rule with
+// transmittance_steps_ segments (HillaireTransmittanceStage).
 void HillaireModel::BuildTransmittance() {
     transmittance_.Resize(kHillaireTransmittanceWidth, kHillaireTransmittanceHeight, 1, 3);
     HillaireTransmittanceStage stage;
@@ -319,7 +320,8 @@ void HillaireModel::Bake(const std::string& directory) const {
           {"channels", 3},
           {"content", "RGB transmittance from (r, mu) to the top of the atmosphere"},
           {"mapping",
-           "seed 004 GetTransmittanceTextureUvFromRMu: H = sqrt(top^2 - bottom^2), rho = "
+           "Bruneton's 2017 implementation notes GetTransmittanceTextureUvFromRMu: H = sqrt(top^2 "
+           "- bottom^2), rho = "
            "sqrt(r^2 - bottom^2), d = distance to top, x_mu = (d - (top - r)) / (rho + H - "
            "(top - r)), x_r = rho / H; u = 0.5/W + x_mu (1 - 1/W), v = 0.5/H + x_r (1 - 1/H)"}},
          {{"name", "multiple_scattering"},

@@ -1,9 +1,9 @@
 // atmos model `hillaire`: Hillaire 2020's LUT-based sky and aerial perspective.
 //
 // Source: S. Hillaire, "A Scalable and Production Ready Sky and Atmosphere
-// Rendering Technique", EGSR 2020 (Computer Graphics Forum 39(4)); seed 003
+// Rendering Technique", EGSR 2020 (Computer Graphics Forum 39(4)); Leenman's 2025 thesis
 // sections 5.2 (Eq. 31), 11.2.4, 11.6, 12.1.1, 12.3; the transmittance table's
-// mapping is seed 004's (Bruneton 2017, GetTransmittanceTextureUvFromRMu).
+// mapping is Bruneton 2017, GetTransmittanceTextureUvFromRMu.
 //
 // Implements, per unit of solar irradiance:
 //  * Transmittance table T(r, mu) to the top of the atmosphere, 256 x 64, seed
@@ -16,7 +16,8 @@
 //      L_2nd = int_Omega L'(x, -w) p_u dw                     (paper Eq. 5-6)
 //      L'(x, v) = int T(x, y) sigma_s(y) p_u T_sun(y) V(y) dt + T(x, g) a/pi (n.s) T_sun(g)
 //      f_ms = int_Omega p_u int sigma_s(y) T(x, y) dt dw       (paper Eq. 7-8)
-//      Psi_ms = L_2nd / (1 - f_ms)                             (paper Eq. 9-10; seed 003 Eq. 31)
+//      Psi_ms = L_2nd / (1 - f_ms)                             (paper Eq. 9-10; Leenman's 2025
+//      thesis Eq. 31)
 //    with the isotropic phase p_u = 1/(4 pi), the planet shadow V and the
 //    ground albedo a (Lambertian, lit by the transmitted sun).
 //  * The ray march (paper Eq. 1-3, 11): along the segment inside the atmosphere,
@@ -49,7 +50,7 @@
 //    perspective volume when the ground is within the volume's last slice
 //    (`--ground-path aerial-perspective`, the default), otherwise from the
 //    sky-view table (its lower half marches to the ground) and the
-//    transmittance table (T(r,mu,d) = T(r_d,-mu_d)/T(r,-mu), seed 004);
+//    transmittance table (T(r,mu,d) = T(r_d,-mu_d)/T(r,-mu), Bruneton's 2017 implementation notes);
 //    between the centres of slices 24 and 31 the two are blended linearly
 //    (no seam where the volume ends; the paper leaves this to the engine);
 //    `--ground-path sky-view` uses the latter for every ground ray. The
@@ -68,7 +69,7 @@
 // Output: radiance per unit solar irradiance (1/sr) and the segment's RGB
 // transmittance. Valid: any camera and sun; multiple scattering approximated
 // (isotropic after the first bounce), so the Mie halo around a low sun differs
-// from the path tracer (seed 003 section 12.1.1).
+// from the path tracer (Leenman's 2025 thesis section 12.1.1).
 //
 // Deviations from the paper's demo: geometry in double, tables in float; the
 // sky-view table is built for a camera at least 1 m above the ground (the
@@ -129,7 +130,7 @@ constexpr double kHillaireSkyViewMinAltitude = 1.0;  // m, for the horizon angle
 
 // --- Table mappings (all ATMOS_HD) -----------------------------------------
 
-// Seed 004 GetTransmittanceTextureUvFromRMu.
+// Bruneton's 2017 implementation notes GetTransmittanceTextureUvFromRMu.
 ATMOS_HD inline void HillaireTransmittanceUv(const AtmosphereParameters& atm, double r, double mu,
                                              double* u, double* v) {
     const double bottom = atm.bottom_radius, top = atm.top_radius;
@@ -144,7 +145,8 @@ ATMOS_HD inline void HillaireTransmittanceUv(const AtmosphereParameters& atm, do
     *v = GetTextureCoordFromUnitRange(rho / H, kHillaireTransmittanceHeight);
 }
 
-// Seed 004 GetRMuFromTransmittanceTextureUv: unit coordinates (x_mu, x_r) -> (r, mu).
+// Bruneton's 2017 implementation notes GetRMuFromTransmittanceTextureUv: unit coordinates (x_mu,
+// x_r) -> (r, mu).
 ATMOS_HD inline void HillaireTransmittanceRMu(const AtmosphereParameters& atm, double x_mu,
                                               double x_r, double* r, double* mu) {
     const double bottom = atm.bottom_radius, top = atm.top_radius;
@@ -263,7 +265,8 @@ struct HillaireEvaluator {
     }
 
     // Transmittance of a segment of length d from (r, mu) that ends on the
-    // ground (seed 004 GetTransmittance with ray_r_mu_intersects_ground).
+    // ground (Bruneton's 2017 implementation notes GetTransmittance with
+    // ray_r_mu_intersects_ground).
     ATMOS_HD Vec3d TransmittanceToGround(double r, double mu, double d) const {
         const double r_d =
             Clamp(Sqrt(d * d + 2.0 * r * mu * d + r * r), atm.bottom_radius, atm.top_radius);

@@ -3,9 +3,9 @@
 // src/atmos/cuda/hillaire_stages.cu).
 //
 // Source and equations: hillaire.h (Hillaire 2020 sections 5.2-5.5, Eq. 1-11;
-// seed 004 for the transmittance mapping). Each stage is one loop body of the
-// former CPU code, unchanged in arithmetic:
-//  * HillaireTransmittanceStage: one transmittance texel (seed 004
+// Bruneton's 2017 implementation notes for the transmittance mapping). Each stage is one loop body
+// of the former CPU code, unchanged in arithmetic:
+//  * HillaireTransmittanceStage: one transmittance texel (Bruneton's 2017 implementation notes
 //    ComputeTransmittanceToTopAtmosphereBoundaryTexture, midpoint rule);
 //  * HillaireMultipleScatteringStage: one Psi_ms texel (paper Eq. 5-10);
 //  * HillaireSkyViewStage: one sky-view texel (paper section 5.3, Eq. 11);
@@ -27,7 +27,7 @@ ATMOS_HD inline Vec4f HillaireTexel(const Vec3d& v) {
     return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), 0.0f};
 }
 
-// Transmittance table (256 x 64 RGB): seed 004
+// Transmittance table (256 x 64 RGB): Bruneton's 2017 implementation notes
 // ComputeTransmittanceToTopAtmosphereBoundaryTexture, optical depth by the
 // midpoint rule with `steps` segments. Item: one texel (x fastest).
 struct HillaireTransmittanceStage {

@@ -161,7 +161,7 @@ ModelInfo HosekWilkieModel::StaticInfo() {
     info.title = "Hosek & Wilkie 2012 analytic sky dome";
     info.citation =
         "Hosek & Wilkie 2012 (ACM TOG 31(4), eq. 8-9; coefficients of the reference "
-        "implementation 1.4a, BSD-3); seed 003 section 5.3 (Eq. 35-37)";
+        "implementation 1.4a, BSD-3); Leenman's 2025 thesis section 5.3 (Eq. 35-37)";
     info.summary =
         "fitted extended-Perez sky (turbidity, ground albedo) for a ground viewer; RGB, XYZ or "
         "spectral 320-720 nm, per unit extraterrestrial solar irradiance";

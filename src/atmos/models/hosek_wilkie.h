@@ -2,7 +2,7 @@
 // 2012 ("An Analytic Model for Full Spectral Sky-Dome Radiance", ACM TOG
 // 31(4), SIGGRAPH 2012) with the authors' published coefficients.
 //
-// Source: the paper's eq. 8-9 (seed 003 section 5.3, eq. 35-37; the seed's
+// Source: the paper's eq. 8-9 (Leenman's 2025 thesis section 5.3, eq. 35-37; the seed's
 // chi drops the paper's exponent 3/2) and its coefficient data (reference
 // implementation 1.4a, BSD-3, shipped in data/hosek-wilkie-2012/ with its
 // licence): for each channel (RGB, CIE XYZ or 11 wavelengths 320-720 nm), 2

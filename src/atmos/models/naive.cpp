@@ -7,7 +7,8 @@ ModelInfo NaiveModel::StaticInfo() {
     info.name = "naive";
     info.title = "Naive single scattering (Nishita 93)";
     info.citation =
-        "Nishita et al. 1993; Terrell 2016 (glsl-atmosphere); seed 003 sections 3.2, 5.1, 11.2.6";
+        "Nishita et al. 1993; Terrell 2016 (glsl-atmosphere); Leenman's 2025 thesis sections 3.2, "
+        "5.1, 11.2.6";
     info.summary = "single scattering by nested numerical integration, Rayleigh + Mie + ozone";
     info.capabilities.multiple_scattering = false;
     info.options = OptionRows().Specs();

@@ -2,16 +2,16 @@
 //
 // Source: Nishita et al. 1993, "Display of the Earth taking into account
 // atmospheric scattering", as formulated by Terrell 2016 (glsl-atmosphere) and
-// used by seed 003 section 11.2.6 (the thesis's "naive" model, with ozone
-// absorption added); equations of seed 003 section 3.2 (Eq. 1, 4, 8, 9).
+// used by Leenman's 2025 thesis section 11.2.6 (the thesis's "naive" model, with ozone
+// absorption added); equations of Leenman's 2025 thesis section 3.2 (Eq. 1, 4, 8, 9).
 //
 // Implements: for the part of the view ray inside the atmosphere, split into
 // `steps` equal segments and sampled at their midpoints x_i,
 //   L = sum_i [ beta_R rho_R(x_i) P_R(nu) + beta_M rho_M(x_i) P_M(nu) ]
 //             T(camera, x_i) T_sun(x_i) ds
 // with T = exp(-tau) over Rayleigh scattering, Mie extinction and ozone
-// absorption (seed 004's layered profiles), T(camera, x_i) from the optical
-// depth accumulated along the view ray up to the midpoint, and T_sun(x_i) from
+// absorption (Bruneton's 2017 implementation notes' layered profiles), T(camera, x_i) from the
+// optical depth accumulated along the view ray up to the midpoint, and T_sun(x_i) from
 // `light_steps` midpoint samples of the light ray to the top of the atmosphere.
 // A light ray that hits the ground contributes nothing (the planet's shadow).
 // Phases: Rayleigh 3/(16 pi)(1+nu^2), Cornette-Shanks for Mie (one or two

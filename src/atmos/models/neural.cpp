@@ -342,7 +342,8 @@ ModelInfo NeuralModel::StaticInfo() {
     ModelInfo info;
     info.name = "neural";
     info.title = "Neural-network sky (thesis fitted model)";
-    info.citation = "seed 003 sections 9.6, 11.2.8, 11.3.2; Bruneton & Neyret 2008 (segments)";
+    info.citation =
+        "Leenman's 2025 thesis sections 9.6, 11.2.8, 11.3.2; Bruneton & Neyret 2008 (segments)";
     info.summary =
         "MLPs for transmittance (2-4-3) and scattering (4-8-8-3), fitted with `atmos fit`";
     info.capabilities.multiple_scattering = true;

@@ -1,6 +1,6 @@
 // atmos model `neural`: the thesis's fitted neural-network sky.
 //
-// Source: seed 003 section 9.6 (networks, 9.6.3 implementation as an
+// Source: Leenman's 2025 thesis section 9.6 (networks, 9.6.3 implementation as an
 // atmosphere: Eq. 43 and 44), 11.2.8, 11.3.2; segment handling after Bruneton &
 // Neyret 2008.
 //
@@ -10,7 +10,7 @@
 // output; the sky radiance per unit solar irradiance along the ray to its end)
 // fitted by `atmos fit` (models/neural_train.h) to a reference model. Per ray:
 //  - a camera outside the atmosphere is moved to where the ray enters it
-//    (seed 003 section 9.6.3); a ray that misses the atmosphere sees nothing;
+//    (Leenman's 2025 thesis section 9.6.3); a ray that misses the atmosphere sees nothing;
 //  - a ray that leaves through the top: T = T(h_v, mu_v), S = S(h_v, mu_v, ...);
 //  - a ray that meets the ground at g is reversed for the transmittance
 //    (section 9.6.3): T = T(g, -v) / T(camera, -v) (Eq. 43), and
@@ -42,7 +42,7 @@
 
 namespace atmos {
 
-// Lowest sun cosine in the training data (seed 003 section 9.1 limits the sun to
+// Lowest sun cosine in the training data (Leenman's 2025 thesis section 9.1 limits the sun to
 // 0..100 degrees; we go a little further so the sky fades out).
 constexpr double kNeuralMinMuS = -0.35;
 
@@ -88,7 +88,7 @@ struct NeuralEvaluator {
             }
             return out;
         }
-        // Viewer moved to the atmosphere's boundary (seed 003 section 9.6.3).
+        // Viewer moved to the atmosphere's boundary (Leenman's 2025 thesis section 9.6.3).
         Vec3d p = camera + dir * seg.t_start;
         double r = Length(p);
         if (r < bottom) {

@@ -1,15 +1,15 @@
 // atmos: the small multilayer perceptrons of the `neural` model (device side).
 //
-// Source: seed 003 section 9.6 (9.6.1 transmittance: one hidden layer of 4,
+// Source: Leenman's 2025 thesis section 9.6 (9.6.1 transmittance: one hidden layer of 4,
 // sigmoid; 9.6.2 scattering: two hidden layers of 8, exp(-x) on the output),
-// inputs as seed 003 section 9.1 (squared height, cosines).
+// inputs as Leenman's 2025 thesis section 9.1 (squared height, cosines).
 //
 // A network is stored in fixed-size arrays (no std containers, trivially
 // copyable) so that evaluators can carry it to the GPU by value. Layer l maps
 // n_l inputs to n_{l+1} outputs: y = act(W x + b), W row-major [out][in].
 // Hidden layers use the logistic sigmoid; the output layer uses the sigmoid
 // (transmittance, values in (0, 1)) or exp(-x) (scattering, values in
-// (0, inf), seed 003 section 9.6.2). Evaluation is in float.
+// (0, inf), Leenman's 2025 thesis section 9.6.2). Evaluation is in float.
 #pragma once
 
 #include "atmos/math.h"
@@ -20,7 +20,7 @@ enum class NeuralOutput : int { kSigmoid = 0, kExpNeg = 1 };
 
 // Input encodings (the fit records which one the weights expect).
 //  kThesis:   transmittance (h^2, mu); scattering (h^2, mu, mu_s, nu) with
-//             h = altitude / atmosphere thickness (seed 003 section 9.1).
+//             h = altitude / atmosphere thickness (Leenman's 2025 thesis section 9.1).
 //  kExtended: scattering adds h, ln(Cornette-Shanks phase(nu)) / 4 and
 //             (mu - mu_horizon(h)); transmittance as kThesis. Beyond the thesis:
 //             the halo and the horizon are given to the network as features
@@ -85,7 +85,7 @@ struct NeuralNet {
                 } else if (output == NeuralOutput::kSigmoid) {
                     out[o] = NeuralSigmoid(z);
                 } else {
-                    // exp(-x), clamped so it stays finite (seed 003 section 9.6.2).
+                    // exp(-x), clamped so it stays finite (Leenman's 2025 thesis section 9.6.2).
                     out[o] = expf(-Max(z, -80.0f));
                 }
             }
@@ -105,7 +105,7 @@ ATMOS_HD inline int NeuralScatteringInputs(NeuralEncoding e) {
     return e == NeuralEncoding::kThesis ? 4 : e == NeuralEncoding::kExtended ? 7 : 8;
 }
 
-// Encodes (altitude, mu) for the transmittance network (seed 003 section 9.1):
+// Encodes (altitude, mu) for the transmittance network (Leenman's 2025 thesis section 9.1):
 // squared normalised height and the view-zenith cosine.
 ATMOS_HD inline void NeuralEncodeTransmittance(double altitude, double thickness, double mu,
                                                float* x) {
@@ -126,7 +126,8 @@ ATMOS_HD inline void NeuralEncodeScattering(NeuralEncoding e, double altitude, d
     x[3] = static_cast<float>(ClampCosine(nu));
     if (e != NeuralEncoding::kThesis) {
         x[4] = static_cast<float>(h);
-        // Cornette-Shanks phase (seed 003 section 3.2 / seed 004), as a log.
+        // Cornette-Shanks phase (Leenman's 2025 thesis section 3.2 / Bruneton's 2017 implementation
+        // notes), as a log.
         const double c = ClampCosine(nu);
         const double k = 3.0 / (8.0 * kPi) * (1.0 - g * g) / (2.0 + g * g);
         const double phase = k * (1.0 + c * c) / Pow(1.0 + g * g - 2.0 * g * c, 1.5);

@@ -405,13 +405,13 @@ NeuralWeights FitNeural(const Model& reference, const AtmosphereParameters& atm,
     }
 
     Mlp tnet;
-    tnet.widths = {td.inputs, 4, kNeuralOutputs};  // seed 003 section 9.6.1
+    tnet.widths = {td.inputs, 4, kNeuralOutputs};  // Leenman's 2025 thesis section 9.6.1
     tnet.output = NeuralOutput::kSigmoid;
     Mlp snet;
     if (large) {
         snet.widths = {sd.inputs, 32, 32, kNeuralOutputs};
     } else {
-        snet.widths = {sd.inputs, 8, 8, kNeuralOutputs};  // seed 003 section 9.6.2
+        snet.widths = {sd.inputs, 8, 8, kNeuralOutputs};  // Leenman's 2025 thesis section 9.6.2
     }
     snet.output = NeuralOutput::kExpNeg;
     NeuralFitReport r;

@@ -1,12 +1,12 @@
 // atmos: fitting the `neural` model's networks (host side; `atmos fit`).
 //
-// Source: seed 003 section 9.6 (Adam, learning rate 0.01; network sizes) and
+// Source: Leenman's 2025 thesis section 9.6 (Adam, learning rate 0.01; network sizes) and
 // 9.1 (training data: transmittance over (h, mu), scattering over
 // (h, mu, mu_s, nu), height squared); Kingma & Ba 2015 (Adam, Algorithm 1).
 //
 // The training data come from a reference model's Sample() (DESIGN.md sample
 // contract): transmittance of rays that reach the top of the atmosphere
-// (mu above the horizon; the model reverses rays that look down, seed 003
+// (mu above the horizon; the model reverses rays that look down, Leenman's 2025 thesis
 // section 9.6.3), and sky radiance per unit irradiance for rays to their end.
 // Loss: mean squared difference of ln(y + eps) (a relative error, so that
 // twilight and the zenith count alike); eps = 1e-4 for the transmittance and
@@ -53,7 +53,7 @@ struct NeuralFitOptions {
     int transmittance_steps = 3000;
     int scattering_steps = 8000;
     int batch = 128;
-    double learning_rate = 0.01;  // seed 003 section 9.6
+    double learning_rate = 0.01;  // Leenman's 2025 thesis section 9.6
     // Beyond the thesis: the step size decays exponentially from
     // learning_rate to final_learning_rate over the steps (equal: constant);
     // the scattering network's only (the transmittance network keeps

@@ -27,7 +27,9 @@ ModelInfo OneilModel::StaticInfo() {
     ModelInfo info;
     info.name = "oneil";
     info.title = "O'Neil 2005 (GPU Gems 2 ch. 16), per pixel";
-    info.citation = "O'Neil 2005, GPU Gems 2 ch. 16; seed 001; seed 003 section 5.1 (Eq. 17)";
+    info.citation =
+        "O'Neil 2005, GPU Gems 2 ch. 16; Raush's O'Neil slides (2018); Leenman's 2025 thesis "
+        "section 5.1 (Eq. 17)";
     info.summary =
         "single scattering, midpoint rule with the fitted scale() optical depth; scale() "
         "refitted per atmosphere in Prepare(); no ozone";

@@ -1,9 +1,9 @@
 // atmos model `oneil`: O'Neil's real-time single scattering (GPU Gems 2,
 // chapter 16, "Accurate Atmospheric Scattering", 2005), evaluated per pixel.
 //
-// Source: O'Neil 2005 as seed 001 presents it (vertex shader "SkyFromAtmosphere":
-// midpoint rule over the view ray, optical depth from the fitted scale()
-// function, fragment-shader phase functions) and seed 003 section 5.1 (Eq. 17).
+// Source: O'Neil 2005 as Raush's O'Neil slides (2018) presents it (vertex shader
+// "SkyFromAtmosphere": midpoint rule over the view ray, optical depth from the fitted scale()
+// function, fragment-shader phase functions) and Leenman's 2025 thesis section 5.1 (Eq. 17).
 //
 // Implements: `steps` midpoint samples x_i of the part of the view ray inside
 // the atmosphere (5 by default, O'Neil's outer integral; cameras in space start

@@ -77,7 +77,8 @@ ModelInfo PreethamModel::StaticInfo() {
     info.name = "preetham";
     info.title = "Preetham, Shirley & Smits 1999 analytic daylight";
     info.citation =
-        "Preetham, Shirley & Smits 1999; Perez et al. 1993; seed 003 sections 5.3 (Eq. 32-34), "
+        "Preetham, Shirley & Smits 1999; Perez et al. 1993; Leenman's 2025 thesis sections 5.3 "
+        "(Eq. 32-34), "
         "11.2.5; spectral form: CIE 15:2004 daylight components (Judd et al. 1964)";
     info.summary =
         "fitted Perez sky (xyY from turbidity) for a ground viewer; luminance / 128 klx as "

@@ -5,7 +5,7 @@
 // the Perez coefficients of Y, x, y as linear functions of turbidity T; zenith
 // luminance Y_z = (4.0453 T - 4.9710) tan(chi) - 0.2155 T + 2.4192 kcd/m^2 with
 // chi = (4/9 - T/120)(pi - 2 theta_s); zenith chromaticities x_z, y_z as
-// [T^2 T 1] M [theta_s^3 theta_s^2 theta_s 1]^T), as seed 003 section 5.3
+// [T^2 T 1] M [theta_s^3 theta_s^2 theta_s 1]^T), as Leenman's 2025 thesis section 5.3
 // (Eq. 32-34) and section 11.2.5 use it.
 //
 // Implements: Y = Y_z F(theta, gamma) / F(0, theta_s) and the same for x and y

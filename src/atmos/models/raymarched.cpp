@@ -5,8 +5,8 @@ namespace atmos {
 ModelInfo RaymarchedModel::StaticInfo() {
     ModelInfo info;
     info.name = "raymarched";
-    info.title = "Raymarched segments with the flat optical depth (seed 003 s. 10.4)";
-    info.citation = "Hillaire 2015; seed 003 sections 10.2-10.5 (Eq. 50-59), 11.2.10";
+    info.title = "Raymarched segments with the flat optical depth (Leenman's 2025 thesis s. 10.4)";
+    info.citation = "Hillaire 2015; Leenman's 2025 thesis sections 10.2-10.5 (Eq. 50-59), 11.2.10";
     info.summary =
         "single scattering summed over a few closed-form segments (Eq. 55), flat optical "
         "depth, ozone shell";

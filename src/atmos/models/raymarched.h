@@ -2,7 +2,7 @@
 // integrated in closed form with the flat optical depth (the thesis's
 // "raymarched" model).
 //
-// Source: seed 003 section 10.4 (Eq. 54-57) and section 11.2.10; optical depth
+// Source: Leenman's 2025 thesis section 10.4 (Eq. 54-57) and section 11.2.10; optical depth
 // of section 10.2 (Eq. 50-51, 53), ozone shell of section 10.5 (Eq. 59).
 //
 // Implements: the view segment inside the atmosphere is cut into `steps`

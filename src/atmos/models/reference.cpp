@@ -180,7 +180,8 @@ ModelInfo ReferenceModel::StaticInfo() {
     info.name = "reference";
     info.title = "Reference path tracer (spectral tracking)";
     info.citation =
-        "seed 003 sections 3.2, 4, 11.2.2; Kutz et al. 2017 (spectral tracking); Novak et al. "
+        "Leenman's 2025 thesis sections 3.2, 4, 11.2.2; Kutz et al. 2017 (spectral tracking); "
+        "Novak et al. "
         "2014 (ratio tracking)";
     info.summary = "unbiased Monte Carlo: all scattering orders, planet shadow, Lambertian ground";
     info.capabilities.multiple_scattering = true;

@@ -1,6 +1,6 @@
 // atmos model `reference`: the Monte Carlo path tracer every model is measured against.
 //
-// Source: seed 003 sections 3.2, 4 and 11.2.2 (delta and ratio tracking after
+// Source: Leenman's 2025 thesis sections 3.2, 4 and 11.2.2 (delta and ratio tracking after
 // Fong et al. 2017 and Pharr et al. 2016, as Hillaire 2020's reference), with
 // two changes that keep it unbiased and make it converge faster:
 //
@@ -18,7 +18,7 @@
 //   channel per path (also unbiased, three times the paths).
 // * A piecewise-constant majorant over 48 spherical shells (altitudes
 //   h_k = Delta (k/48)^2, fine near the ground), each the exact maximum of the
-//   extinction over its shell (per-layer critical points of seed 004's
+//   extinction over its shell (per-layer critical points of Bruneton's 2017 implementation notes'
 //   profiles). Tracking steps to the shell boundary and resamples there
 //   (memoryless). A global majorant is the special case of one shell
 //   (`--shells 1`); bench/reference_bench.cpp measures both.

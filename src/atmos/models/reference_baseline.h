@@ -1,5 +1,5 @@
 // The reference's baseline estimator (`estimator=thesis`): the thesis's
-// (seed 003 section 4) one random channel per path, delta tracking, uniform
+// (Leenman's 2025 thesis section 4) one random channel per path, delta tracking, uniform
 // directions; kept to measure the others against.
 #pragma once
 

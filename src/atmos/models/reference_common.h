@@ -55,7 +55,7 @@ enum class ReferenceEstimator : int {
     // Spectral tracking with a forced first collision and ratio-tracked sun
     // (the default until this round).
     kTracking = 1,
-    // The thesis's estimator (seed 003 section 4), kept as a baseline.
+    // The thesis's estimator (Leenman's 2025 thesis section 4), kept as a baseline.
     kThesis = 2,
 };
 
@@ -164,12 +164,11 @@ ATMOS_HD inline Vec3d AdaptiveOpticalDepth(const AtmosphereParameters& atm, cons
 // The sun's transmittance from a point (r, mu_s) to space: 0 when the ray meets
 // the ground (exact geometry), else exp(-tau) with tau = beta_R c_R + beta_M,ext
 // c_M + beta_A c_A, the column densities c (m, density x length) bilinear in a
-// table on seed 004's transmittance parameterisation (x_r = rho / H, x_mu =
-// (d - d_min) / (d_max - d_min)), filled by Simpson quadrature
-// (BuildSunColumnTable). The columns do not depend on wavelength: every batch of
-// a spectral run shares one table (SharedSunColumnTable); bilinear interpolation
-// is linear, so tau is what a table of optical depths would give. Its error
-// against exact quadrature is measured and bounded by a test
+// table on Bruneton's 2017 implementation notes' transmittance parameterisation (x_r = rho / H,
+// x_mu = (d - d_min) / (d_max - d_min)), filled by Simpson quadrature (BuildSunColumnTable). The
+// columns do not depend on wavelength: every batch of a spectral run shares one table
+// (SharedSunColumnTable); bilinear interpolation is linear, so tau is what a table of optical
+// depths would give. Its error against exact quadrature is measured and bounded by a test
 // (ReferenceHybrid.SunTableMatchesQuadrature).
 struct SunTransmittanceTable {
     TableView columns;  // 3 channels: Rayleigh, Mie, absorption column to the top boundary
@@ -177,8 +176,8 @@ struct SunTransmittanceTable {
     Vec3d rayleigh, mie_extinction, absorption;  // the coefficients (1/m) per channel
     // true: the table does not resolve this atmosphere (SunTableResolves
     // failed: e.g. an 8 km scale height on a planet of radius 1e9 m, whose
-    // seed 004 parameterisation puts the whole atmosphere in one texel): the
-    // evaluator integrates each sun ray by AdaptiveOpticalDepth instead.
+    // Bruneton's 2017 implementation notes parameterisation puts the whole atmosphere in one
+    // texel): the evaluator integrates each sun ray by AdaptiveOpticalDepth instead.
     bool direct = false;
 
     // The table `columns` (BuildSunColumnTable) of the atmosphere `atm`.

@@ -27,7 +27,7 @@ struct ReferenceTracking {
     // output and `sample` use it; a radiance pass without the disc leaves it 1.
     bool need_transmittance = true;
     int max_order = 0;  // 0: unlimited (Russian roulette)
-    // false: the thesis's estimator (seed 003 section 4: one random channel per
+    // false: the thesis's estimator (Leenman's 2025 thesis section 4: one random channel per
     // path, plain delta tracking against the shells' majorant, delta tracking
     // toward the sun, directions sampled uniformly). Kept as the baseline the
     // spectral estimator is measured against (bench, docs/models/reference.md).

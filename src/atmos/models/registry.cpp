@@ -44,7 +44,7 @@ ModelInfo EmptyModel::StaticInfo() {
     ModelInfo info;
     info.name = "empty";
     info.title = "Empty (constant white)";
-    info.citation = "seed 003 section 11.2.1";
+    info.citation = "Leenman's 2025 thesis section 11.2.1";
     info.summary = "no physics: the overhead baseline of the render loop";
     return info;
 }

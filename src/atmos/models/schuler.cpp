@@ -8,7 +8,8 @@ ModelInfo SchulerModel::StaticInfo() {
     ModelInfo info;
     info.name = "schuler";
     info.title = "Naive integrator with Schuler's Chapman light depth";
-    info.citation = "Schuler 2012 (GPU Pro 3); seed 003 sections 5.1 (Eq. 22-25), 11.2.7";
+    info.citation =
+        "Schuler 2012 (GPU Pro 3); Leenman's 2025 thesis sections 5.1 (Eq. 22-25), 11.2.7";
     info.summary =
         "single scattering, view ray by the midpoint rule, light optical depth by the "
         "Chapman approximation; no ozone";

@@ -2,7 +2,7 @@
 // ray's optical depth from Schuler's Chapman-function approximation.
 //
 // Source: Schuler 2012, "An Approximation to the Chapman Grazing-Incidence
-// Function for Atmospheric Scattering" (GPU Pro 3), as seed 003 section 5.1
+// Function for Atmospheric Scattering" (GPU Pro 3), as Leenman's 2025 thesis section 5.1
 // (Eq. 22-25) gives it and section 11.2.7 uses it.
 //
 // Implements: the view ray of `naive` (midpoint rule, `steps` samples, the

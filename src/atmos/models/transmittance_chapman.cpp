@@ -6,7 +6,7 @@ ModelInfo TransmittanceChapmanModel::StaticInfo() {
     ModelInfo info;
     info.name = "transmittance-chapman";
     info.title = "Schuler 2012 Chapman-approximation transmittance";
-    info.citation = "Schuler 2012 (GPU Pro 3); seed 003 section 5.1 (Eq. 22-25)";
+    info.citation = "Schuler 2012 (GPU Pro 3); Leenman's 2025 thesis section 5.1 (Eq. 22-25)";
     info.summary = "view-ray transmittance from Schuler's Chapman approximation; no ozone";
     info.capabilities = TransmittanceCapabilities();
     info.options = OptionRows().Specs();
@@ -18,7 +18,8 @@ std::vector<std::pair<std::string, double>> ChapmanUnitChoices() {
 }
 
 const char* const kChapmanUnitHelp =
-    "length unit of the Chapman approximation: seed (scale height, seed 003 Eq. 25) or "
+    "length unit of the Chapman approximation: seed (scale height, Leenman's 2025 thesis Eq. 25) "
+    "or "
     "half-height (H ln 2, Schuler's code)";
 
 const OptionTable<TransmittanceChapmanOptions>& TransmittanceChapmanModel::OptionRows() {

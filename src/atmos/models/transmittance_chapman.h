@@ -1,7 +1,7 @@
 // atmos model `transmittance-chapman`: the view ray's transmittance from
 // Schuler 2012's Chapman-function approximation.
 //
-// Source: seed 003 section 5.1, Eq. 22-25. Implements: each exponential
+// Source: Leenman's 2025 thesis section 5.1, Eq. 22-25. Implements: each exponential
 // medium's optical length to infinity from ChapmanLengthToInfinity (Eq. 24-25,
 // mu >= 0 branch), segments by SegmentFromToInfinity (which reproduces Eq. 24's
 // complement branch for rays that pass the tangent point, and uses two upward

@@ -1,6 +1,6 @@
 // atmos: the shared shape of the transmittance models (`transmittance-*`).
 //
-// A transmittance model computes only the view ray's transmittance (seed 003
+// A transmittance model computes only the view ray's transmittance (Leenman's 2025 thesis
 // section 11.3): its capabilities say radiance = false, its Evaluate() fills
 // RayResult::transmittance = exp(-tau) over the part of the ray inside the
 // atmosphere (to the ground or to space; a camera in space starts where the

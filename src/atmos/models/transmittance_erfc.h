@@ -1,7 +1,7 @@
 // atmos model `transmittance-erfc`: the view ray's transmittance from Bruneton
 // & Neyret 2008's erfc approximation of the optical depth.
 //
-// Source: seed 003 section 5.1, Eq. 26-30 and Listing 3 (from Bruneton &
+// Source: Leenman's 2025 thesis section 5.1, Eq. 26-30 and Listing 3 (from Bruneton &
 // Neyret's 2008 implementation). Implements: each exponential medium's optical
 // length along the segment (physics/analytic_optical_depth.h,
 // ErfcSegmentLength: altitude along the ray h + t mu + t^2/(2r), Eq. 27-28,

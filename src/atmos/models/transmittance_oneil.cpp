@@ -6,7 +6,9 @@ ModelInfo TransmittanceOneilModel::StaticInfo() {
     ModelInfo info;
     info.name = "transmittance-oneil";
     info.title = "O'Neil 2005 scale() transmittance";
-    info.citation = "O'Neil 2005, GPU Gems 2 ch. 16; seed 001; seed 003 Eq. 17";
+    info.citation =
+        "O'Neil 2005, GPU Gems 2 ch. 16; Raush's O'Neil slides (2018); Leenman's 2025 thesis Eq. "
+        "17";
     info.summary = "view-ray transmittance from O'Neil's fitted scale() (refit per atmosphere)";
     info.capabilities = TransmittanceCapabilities();
     info.capabilities.precomputed = true;

@@ -110,8 +110,8 @@ PolynomialSigmoid FitPolynomialSigmoid(const AtmosphereParameters& atm, double* 
 ModelInfo TransmittancePolynomialModel::StaticInfo() {
     ModelInfo info;
     info.name = "transmittance-polynomial";
-    info.title = "Polynomial-sigmoid transmittance fit (seed 003 Eq. 42)";
-    info.citation = "seed 003 section 9.5 (Eq. 42)";
+    info.title = "Polynomial-sigmoid transmittance fit (Leenman's 2025 thesis Eq. 42)";
+    info.citation = "Leenman's 2025 thesis section 9.5 (Eq. 42)";
     info.summary =
         "view-ray transmittance 1/(1+exp(-a1-a2 h-a3 mu-a4 mu^2)) per channel, least squares "
         "in Prepare()";

@@ -1,7 +1,7 @@
 // atmos model `transmittance-polynomial`: the view ray's transmittance from
-// the polynomial-sigmoid fit of seed 003 Eq. 42.
+// the polynomial-sigmoid fit of Leenman's 2025 thesis Eq. 42.
 //
-// Source: seed 003 section 9.5, Eq. 42:
+// Source: Leenman's 2025 thesis section 9.5, Eq. 42:
 //   T(h, mu) = 1 / (1 + exp(-a1 - a2 h - a3 mu - a4 mu^2))
 // (h the viewer's altitude, mu = cos theta_v), the transmittance of the whole
 // ray to the top of the atmosphere.

@@ -6,7 +6,7 @@ ModelInfo TransmittanceReferenceModel::StaticInfo() {
     ModelInfo info;
     info.name = "transmittance-reference";
     info.title = "Reference transmittance (Riemann sum, 128 steps)";
-    info.citation = "seed 003 section 11.3.1";
+    info.citation = "Leenman's 2025 thesis section 11.3.1";
     info.summary = "view-ray transmittance by a 128-step midpoint Riemann sum (all media)";
     info.capabilities = TransmittanceCapabilities();
     info.options = OptionRows().Specs();

@@ -1,9 +1,9 @@
 // atmos model `transmittance-reference`: the view ray's transmittance by a
 // Riemann sum of the extinction over the ray.
 //
-// Source: seed 003 section 11.3.1 ("a naive Riemann integrator ... 128 steps");
-// optical depth of seed 003 Eq. 1 and 4 with seed 004's layered profiles
-// (Rayleigh scattering + Mie extinction + ozone absorption, the tent profile).
+// Source: Leenman's 2025 thesis section 11.3.1 ("a naive Riemann integrator ... 128 steps");
+// optical depth of Leenman's 2025 thesis Eq. 1 and 4 with Bruneton's 2017 implementation notes'
+// layered profiles (Rayleigh scattering + Mie extinction + ozone absorption, the tent profile).
 // Implements: tau = sum over `steps` (default 128) equal parts of the segment of
 // the extinction at each part's midpoint times its length; T = exp(-tau).
 // Output: transmittance only (radiance = false). Valid: anywhere; the midpoint

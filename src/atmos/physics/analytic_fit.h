@@ -1,6 +1,6 @@
 // atmos: host-side least-squares fits of the analytic models (O'Neil's scale()
-// polynomial, seed 001 / seed 003 Eq. 17) and the numerical optical lengths
-// they are fitted to.
+// polynomial, Raush's O'Neil slides (2018) / Leenman's 2025 thesis Eq. 17) and the numerical
+// optical lengths they are fitted to.
 #pragma once
 
 #include "physics/analytic_optical_depth.h"

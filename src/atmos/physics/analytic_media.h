@@ -1,6 +1,6 @@
 // atmos: the atmosphere as the analytic models see it: two exponential media
 // (Rayleigh, Mie) with one scale height each, and ozone as a constant-density
-// shell (seed 003 section 10.5, Eq. 59).
+// shell (Leenman's 2025 thesis section 10.5, Eq. 59).
 //
 // Mapping from the canonical parameters (DESIGN.md): each layered density
 // profile's upper layer exp_term * exp(-h / H) gives the scale height H
@@ -47,7 +47,7 @@ struct MediaLengths {
 };
 
 // exp(-a) (1 - exp(-(b - a))) / (b - a): the integral over u in [0, 1] of
-// exp(-(a + u (b - a))), the segment integral of seed 003 Eq. 46-47 / 54-55 with
+// exp(-(a + u (b - a))), the segment integral of Leenman's 2025 thesis Eq. 46-47 / 54-55 with
 // the exponent varying linearly from a to b. Stable when b ~ a (limit exp(-a)).
 ATMOS_HD inline double LinearExpIntegral(double a, double b) {
     const double d = b - a;

@@ -8,12 +8,12 @@
 // segments are built from those by differences (SegmentFromToInfinity below).
 //
 // Sources:
-//   flat / homogeneous sphere   seed 003 section 10.2, Eq. 50-51 (looking up),
+//   flat / homogeneous sphere   Leenman's 2025 thesis section 10.2, Eq. 50-51 (looking up),
 //                               section 10.3, Eq. 53 (looking down)
-//   Chapman (Schuler 2012)      seed 003 section 5.1, Eq. 22-25
-//   erfc (Bruneton & Neyret 08) seed 003 section 5.1, Eq. 26-30 and Listing 3
-//   O'Neil 2005 scale()         seed 001 (vertex shader "scale"), seed 003 Eq. 17
-//   ozone shell                 seed 003 section 10.5, Eq. 59
+//   Chapman (Schuler 2012)      Leenman's 2025 thesis section 5.1, Eq. 22-25
+//   erfc (Bruneton & Neyret 08) Leenman's 2025 thesis section 5.1, Eq. 26-30 and Listing 3
+//   O'Neil 2005 scale()         Raush's O'Neil slides (2018) (vertex shader "scale"), Leenman's
+//   2025 thesis Eq. 17 ozone shell                 Leenman's 2025 thesis section 10.5, Eq. 59
 #pragma once
 
 #include "atmos/atmosphere.h"
@@ -33,7 +33,7 @@ ATMOS_HD inline double ClampLength(double l) { return Clamp(l, 0.0, kMaxOpticalL
 ATMOS_HD inline double SafeExp(double x) { return Exp(Clamp(x, -700.0, 60.0)); }
 
 // ---------------------------------------------------------------------------
-// Flat / homogeneous sphere (seed 003 section 10.2-10.3).
+// Flat / homogeneous sphere (Leenman's 2025 thesis section 10.2-10.3).
 
 // Eq. 51: density at the point times the length of the ray (r, mu) inside the
 // homogeneous sphere of radius r + H: exp(-h/H) (sqrt((r+H)^2 - r^2 + r^2 mu^2) - r mu).
@@ -59,7 +59,7 @@ ATMOS_HD inline double FlatLengthToInfinity(double r, double mu, double scale_he
 }
 
 // ---------------------------------------------------------------------------
-// Chapman function approximation of Schuler 2012 (seed 003 Eq. 24-25).
+// Chapman function approximation of Schuler 2012 (Leenman's 2025 thesis Eq. 24-25).
 
 // Optical length (m) from (r, mu) to infinity for density exp(-(r' - bottom)/H):
 //   mu >= 0: H exp(-h/H) c / (1 + c mu),                       c = sqrt(r / (u H))
@@ -86,7 +86,7 @@ ATMOS_HD inline double ChapmanLengthToInfinity(double r, double mu, double scale
 }
 
 // ---------------------------------------------------------------------------
-// Bruneton & Neyret 2008's erfc approximation (seed 003 Eq. 27-30, Listing 3).
+// Bruneton & Neyret 2008's erfc approximation (Leenman's 2025 thesis Eq. 27-30, Listing 3).
 
 // Eq. 30 in the scaled form used by Listing 3: exp(x^2) erfc(x) / 2 for x >= 0,
 // 1 / (2.3193 x + sqrt(1.52 x^2 + 4)).
@@ -123,7 +123,8 @@ ATMOS_HD inline double ErfcSegmentLength(double r, double mu, double d, double s
 }
 
 // ---------------------------------------------------------------------------
-// O'Neil 2005 (GPU Gems 2 ch. 16; seed 001 "scale"; seed 003 Eq. 17).
+// O'Neil 2005 (GPU Gems 2 ch. 16; Raush's O'Neil slides (2018) "scale"; Leenman's 2025 thesis Eq.
+// 17).
 
 // The fitted optical length of O'Neil's scale(): in units of the atmosphere's
 // thickness L = top - bottom, from a point at normalised altitude h/L looking
@@ -159,7 +160,7 @@ struct OneilScale {
 // only for mu >= 0 (where the approximations are valid) by differences:
 //   ray going up at both ends:   f(p0, mu0) - f(p1, mu1)
 //   ray going down at both ends: f(p1, -mu1) - f(p0, -mu0)   (reversed ray;
-//                                Bruneton & Neyret 2008's trick, seed 003 s. 11.3.3)
+//                                Bruneton & Neyret 2008's trick, Leenman's 2025 thesis s. 11.3.3)
 //   down then up (crosses the tangent point c): 2 f(c, 0) - f(p0, -mu0) - f(p1, mu1)
 //                                (Eq. 53's decomposition)
 template <typename F>
@@ -179,7 +180,7 @@ ATMOS_HD inline double SegmentFromToInfinity(const F& f, double r0, double mu0, 
 }
 
 // ---------------------------------------------------------------------------
-// Ozone as a constant-density shell (seed 003 section 10.5, Eq. 59).
+// Ozone as a constant-density shell (Leenman's 2025 thesis section 10.5, Eq. 59).
 
 struct OzoneShell {
     double r_inner = 0.0;  // m from the centre

@@ -1,10 +1,10 @@
 // atmos: the canonical Earth atmosphere and the validation of atmosphere parameters.
 //
 // Sources: DESIGN.md "Canonical parameters" (the seed thesis's comparison setup,
-// Hillaire 2020 demo values); seed 004 (Bruneton 2017) for the layered density
+// Hillaire 2020 demo values); Bruneton 2017 for the layered density
 // profile, its ozone layer (two linear layers, 0 below 10 km, 1 at 25 km, 0
-// above 40 km) and mu_s_min = cos(102 deg) of its demo; seed 000 sections 1.4-1.8
-// for the radii, the Rayleigh/Mie coefficients, the scale heights and g = 0.8.
+// above 40 km) and mu_s_min = cos(102 deg) of its demo; Boody's Atmosphere Plus notes
+// sections 1.4-1.8 for the radii, the Rayleigh/Mie coefficients, the scale heights and g = 0.8.
 #include <charconv>
 #include <cmath>
 #include <string>
@@ -84,7 +84,7 @@ void CheckProfile(const std::string& field, const DensityProfile& profile) {
 
 }  // namespace
 
-// One exponential exp(-h / H): seed 004's rayleigh_layer / mie_layer
+// One exponential exp(-h / H): Bruneton's 2017 implementation notes' rayleigh_layer / mie_layer
 // (DensityProfileLayer(0, 1, -1/H, 0, 0)) in layers[1]; layers[0] has width 0
 // so it never applies.
 DensityProfile ExponentialProfile(double scale_height) {
@@ -118,20 +118,21 @@ double EffectiveTopRadius(const AtmosphereParameters& a, double column_depth) {
 
 AtmosphereParameters EarthAtmosphere() {
     AtmosphereParameters a;
-    // Seed 000 section 1.4 (Hillaire 2020): R_p and R_a.
+    // Boody's Atmosphere Plus notes section 1.4 (Hillaire 2020): R_p and R_a.
     a.bottom_radius = 6360e3;
     a.top_radius = 6460e3;
-    // Seed 000 sections 1.6 and 1.8: beta_R^s, H_R = 8 km (no Rayleigh absorption).
+    // Boody's Atmosphere Plus notes sections 1.6 and 1.8: beta_R^s, H_R = 8 km (no Rayleigh
+    // absorption).
     a.rayleigh_scattering = Vec3d(5.802e-6, 13.558e-6, 33.1e-6);
     a.rayleigh_density = ExponentialProfile(8000.0);
     // Hillaire 2020 demo: Mie scattering 3.996e-6, extinction 4.44e-6 (absorption
-    // 0.444e-6), H_M = 1.2 km, Cornette-Shanks g = 0.8 (seed 000 section 1.7).
+    // 0.444e-6), H_M = 1.2 km, Cornette-Shanks g = 0.8 (Boody's Atmosphere Plus notes section 1.7).
     a.mie_scattering = Vec3d(3.996e-6);
     a.mie_extinction = Vec3d(4.44e-6);
     a.mie_density = ExponentialProfile(1200.0);
     a.mie_phase_g = 0.8;
-    // Ozone: absorption only, seed 004's demo tent profile (0 below 10 km, 1 at
-    // 25 km, 0 above 40 km; GetLayerDensity clamps to [0, 1]).
+    // Ozone: absorption only, Bruneton's 2017 implementation notes' demo tent profile (0 below 10
+    // km, 1 at 25 km, 0 above 40 km; GetLayerDensity clamps to [0, 1]).
     a.absorption_extinction = Vec3d(0.650e-6, 1.881e-6, 0.085e-6);
     a.absorption_density.layers[0].width = 25000.0;
     a.absorption_density.layers[0].linear_term = 1.0 / 15000.0;
@@ -141,7 +142,8 @@ AtmosphereParameters EarthAtmosphere() {
     a.ground_albedo = Vec3d(0.0);
     a.sun_angular_radius = 0.004675;
     a.solar_irradiance = Vec3d(1.0);
-    // Seed 004 demo: max_sun_zenith_angle = 102 / 180 * pi (the half-precision case).
+    // Bruneton's 2017 implementation notes demo: max_sun_zenith_angle = 102 / 180 * pi (the
+    // half-precision case).
     a.mu_s_min = std::cos(102.0 / 180.0 * kPi);
     return a;
 }

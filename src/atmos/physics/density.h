@@ -1,7 +1,7 @@
 // atmos: density profiles of the atmosphere's constituents.
 //
-// Source: seed 004 (Bruneton 2017, functions.glsl "GetLayerDensity",
-// "GetProfileDensity"). Densities are dimensionless multipliers of the
+// Source: Bruneton 2017, functions.glsl "GetLayerDensity",
+// "GetProfileDensity". Densities are dimensionless multipliers of the
 // coefficients in AtmosphereParameters, clamped to [0, 1] as in the seed.
 #pragma once
 
@@ -35,7 +35,8 @@ ATMOS_HD inline Densities GetDensities(const AtmosphereParameters& atm, double a
 }
 
 // Extinction coefficient (1/m, per channel) at the given densities: Rayleigh
-// scattering + Mie extinction + absorption (seed 004, ComputeTransmittance...).
+// scattering + Mie extinction + absorption (Bruneton's 2017 implementation notes,
+// ComputeTransmittance...).
 ATMOS_HD inline Vec3d Extinction(const AtmosphereParameters& atm, const Densities& d) {
     return atm.rayleigh_scattering * d.rayleigh + atm.mie_extinction * d.mie +
            atm.absorption_extinction * d.absorption;

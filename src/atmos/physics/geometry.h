@@ -1,8 +1,8 @@
 // atmos: ray / sphere geometry of a spherical planet, in double precision.
 //
-// Source: seed 004 (Bruneton 2017, functions.glsl "Intersections":
+// Source: Bruneton 2017, functions.glsl "Intersections":
 // DistanceToTopAtmosphereBoundary, DistanceToBottomAtmosphereBoundary,
-// RayIntersectsGround), extended with a general ray / sphere intersection for
+// RayIntersectsGround, extended with a general ray / sphere intersection for
 // cameras anywhere (including space) that uses the numerically stable form of
 // the quadratic (Press et al., Numerical Recipes 5.6), so grazing rays and
 // cameras at 6.4e6 m keep their precision.
@@ -17,7 +17,7 @@
 namespace atmos {
 
 // Distance from (r, mu) to the sphere of radius `top` along the ray, for a point
-// inside it (r <= top). Seed 004: -r mu + sqrt(r^2 (mu^2 - 1) + top^2).
+// inside it (r <= top). Bruneton's 2017 implementation notes: -r mu + sqrt(r^2 (mu^2 - 1) + top^2).
 ATMOS_HD inline double DistanceToTopAtmosphereBoundary(double r, double mu, double top) {
     ATMOS_DASSERT(mu >= -1.0 && mu <= 1.0);
     const double discriminant = r * r * (mu * mu - 1.0) + top * top;
@@ -25,17 +25,18 @@ ATMOS_HD inline double DistanceToTopAtmosphereBoundary(double r, double mu, doub
 }
 
 // Distance from (r, mu) to the ground sphere of radius `bottom` (nearest hit),
-// for a ray that intersects it. Seed 004: -r mu - sqrt(r^2 (mu^2 - 1) + bottom^2).
+// for a ray that intersects it. Bruneton's 2017 implementation notes: -r mu - sqrt(r^2 (mu^2 - 1) +
+// bottom^2).
 ATMOS_HD inline double DistanceToBottomAtmosphereBoundary(double r, double mu, double bottom) {
     ATMOS_DASSERT(mu >= -1.0 && mu <= 1.0);
     const double discriminant = r * r * (mu * mu - 1.0) + bottom * bottom;
     return Max(-r * mu - SafeSqrt(discriminant), 0.0);
 }
 
-// True when the ray (r, mu) with r >= bottom hits the ground sphere. Seed 004:
-// mu < 0 and r^2 (mu^2 - 1) + bottom^2 >= 0. The discriminant is evaluated as
-// bottom^2 - r^2 (1 - mu^2) = (bottom - r)(bottom + r) + (r mu)^2 so that a
-// camera on the ground (r == bottom) looking just below the horizon is exact.
+// True when the ray (r, mu) with r >= bottom hits the ground sphere. Bruneton's 2017 implementation
+// notes: mu < 0 and r^2 (mu^2 - 1) + bottom^2 >= 0. The discriminant is evaluated as bottom^2 - r^2
+// (1 - mu^2) = (bottom - r)(bottom + r) + (r mu)^2 so that a camera on the ground (r == bottom)
+// looking just below the horizon is exact.
 ATMOS_HD inline bool RayIntersectsGround(double r, double mu, double bottom) {
     ATMOS_DASSERT(mu >= -1.0 && mu <= 1.0);
     return mu < 0.0 && (bottom - r) * (bottom + r) + (r * mu) * (r * mu) >= 0.0;

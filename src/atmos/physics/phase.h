@@ -3,16 +3,18 @@
 // nu is the cosine of the scattering angle: the angle between the direction the
 // light travels before and after scattering, i.e. nu = dot(view, sun) for a view
 // direction pointing away from the camera and a direction pointing to the sun
-// (seed 004 convention). Sources:
-//   Rayleigh:         3/(16 pi) (1 + nu^2)                     seed 004 RayleighPhaseFunction
-//   Cornette-Shanks:  3/(8 pi) (1-g^2)(1+nu^2) / ((2+g^2)(1+g^2-2 g nu)^1.5)
-//                                                               seed 003 Eq. 5, seed 004
+// (Bruneton's 2017 implementation notes convention). Sources:
+//   Rayleigh:         3/(16 pi) (1 + nu^2)                     Bruneton's 2017 implementation notes
+//   RayleighPhaseFunction Cornette-Shanks:  3/(8 pi) (1-g^2)(1+nu^2) / ((2+g^2)(1+g^2-2 g nu)^1.5)
+//                                                               Leenman's 2025 thesis Eq. 5,
+//                                                               Bruneton's 2017 implementation
+//                                                               notes
 //   Henyey-Greenstein: 1/(4 pi) (1-g^2) / (1+g^2-2 g nu)^1.5    Henyey & Greenstein 1941
-//                     (seed 003 Eq. 6 writes +2g cos theta with theta measured
+//                     (Leenman's 2025 thesis Eq. 6 writes +2g cos theta with theta measured
 //                      from the backward direction; here nu = +cos of the angle
 //                      between propagation directions, so forward peaks at nu = 1)
 //   Mie:              (1 - w) CS(g) + w CS(g2)                 MiePhase (two lobes)
-//   isotropic:        1/(4 pi)                                  seed 003 Eq. 7
+//   isotropic:        1/(4 pi)                                  Leenman's 2025 thesis Eq. 7
 #pragma once
 
 #include "atmos/atmosphere.h"

@@ -1,6 +1,6 @@
 // atmos: the single-scattering integral along a view ray, by the midpoint rule.
 //
-// Source: seed 003 section 3.2 (Eq. 8, 9) and section 5.1 (Nishita 93 as
+// Source: Leenman's 2025 thesis section 3.2 (Eq. 8, 9) and section 5.1 (Nishita 93 as
 // formulated by Terrell 2016): for the part of the view ray inside the
 // atmosphere, `steps` equal segments sampled at their midpoints x_i,
 //   L = sum_i [ beta_R rho_R(x_i) P_R(nu) + beta_M rho_M(x_i) P_M(nu) ]

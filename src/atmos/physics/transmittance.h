@@ -1,9 +1,9 @@
 // atmos: numerical optical depth and transmittance.
 //
 // Optical depth tau = integral of the extinction coefficient along a ray
-// (seed 003 Eq. 1 and 4; seed 004 ComputeOpticalLengthToTopAtmosphereBoundary).
-// These functions integrate it numerically: the reference for the closed forms
-// and approximations of the other models.
+// (Leenman's 2025 thesis Eq. 1 and 4; Bruneton's 2017 implementation notes
+// ComputeOpticalLengthToTopAtmosphereBoundary). These functions integrate it numerically: the
+// reference for the closed forms and approximations of the other models.
 #pragma once
 
 #include "atmos/atmosphere.h"
@@ -15,7 +15,7 @@ namespace atmos {
 
 // Optical length (metres at density 1) of `profile` along the segment
 // p(t) = origin + t dir, t in [0, length], by the composite trapezoidal rule
-// with `samples` intervals (seed 004 uses 500).
+// with `samples` intervals (Bruneton's 2017 implementation notes uses 500).
 ATMOS_HD inline double OpticalLength(const AtmosphereParameters& atm, const DensityProfile& profile,
                                      const Vec3d& origin, const Vec3d& dir, double length,
                                      int samples) {
@@ -45,7 +45,7 @@ ATMOS_HD inline Vec3d OpticalDepth(const AtmosphereParameters& atm, const Vec3d&
     return sum * dx;
 }
 
-// Optical depth from (r, mu) to the top of the atmosphere (seed 004's
+// Optical depth from (r, mu) to the top of the atmosphere (Bruneton's 2017 implementation notes'
 // parameterisation), for a ray that does not hit the ground.
 ATMOS_HD inline Vec3d OpticalDepthToTopAtmosphereBoundary(const AtmosphereParameters& atm, double r,
                                                           double mu, int samples) {
