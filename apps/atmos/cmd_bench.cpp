@@ -46,14 +46,7 @@ int CmdBench(BenchOptions o) {
     ThreadLimit limit(o.study.threads);
     const BackendScope backend_scope(ParseBackend(o.study.backend));
     const bool spectral = !c.wavelengths.empty();
-    // Beside the CSV, unless the CSV goes to a stream (/dev/null, stdout, a
-    // FIFO): then only where --stages-output names it.
-    const std::string stages_path = !o.stages_output.empty() ? o.stages_output
-                                    : IsStreamOutput(o.output)
-                                        ? std::string()
-                                        : (fs::path(o.output).parent_path() /
-                                           (fs::path(o.output).stem().string() + "_stages.csv"))
-                                              .string();
+    const std::string stages_path = BenchStagesPath(o.output, o.stages_output);
     if (fs::path(o.output).has_parent_path() && !IsStreamOutput(o.output))
         fs::create_directories(fs::path(o.output).parent_path());
     CheckOutputFile(o.output);

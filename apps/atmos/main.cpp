@@ -4,7 +4,6 @@
 // status 2 (issue 38 item 6: out of memory and unexpected exceptions too). Each
 // subcommand registers itself from its own file (cli_common.h).
 #include <CLI/CLI.hpp>
-#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -13,8 +12,8 @@
 #include <vector>
 
 #include "atmos/error.h"
-#include "atmos/model.h"
 #include "cli_common.h"
+#include "harness/listing.h"
 
 int main(int argc, char** argv) {
     using namespace atmos::cli;
@@ -73,25 +72,8 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ExtrasError& e) {
         // A model option written as a flag (the syntax before issue 14)?
-        std::string hint, given_model;
-        for (int i = 1; i + 1 < argc; ++i) {
-            const std::string arg = argv[i];
-            if (arg == "--model" || arg == "-m") given_model = argv[i + 1];
-        }
-        given_model = given_model.substr(0, given_model.find(':'));
-        for (int i = 1; i < argc && hint.empty(); ++i) {
-            const std::string arg = argv[i];
-            if (arg.rfind("--", 0) != 0) continue;
-            for (const atmos::ModelInfo& info : atmos::ListModels()) {
-                if (!given_model.empty() && info.name != given_model) continue;
-                for (const atmos::ModelOptionSpec& spec : info.options) {
-                    if (arg.substr(2) == spec.name && hint.empty()) {
-                        hint = " (model options are part of the model: --model " + info.name + ":" +
-                               spec.name + "=VALUE; `atmos list " + info.name + "` prints them)";
-                    }
-                }
-            }
-        }
+        const std::string hint =
+            atmos::ModelOptionFlagHint(std::vector<std::string>(argv + 1, argv + argc));
         std::fprintf(stderr, "atmos: error: %s%s\n", e.what(), hint.c_str());
         return 2;
     } catch (const CLI::ParseError& e) {

@@ -51,4 +51,25 @@ std::string ModelCapabilitiesText(const ModelInfo& info) {
     return text;
 }
 
+std::string ModelOptionFlagHint(const std::vector<std::string>& args) {
+    std::string given_model;
+    for (size_t i = 0; i + 1 < args.size(); ++i) {
+        if (args[i] == "--model" || args[i] == "-m") given_model = args[i + 1];
+    }
+    given_model = given_model.substr(0, given_model.find(':'));
+    for (const std::string& arg : args) {
+        if (arg.rfind("--", 0) != 0) continue;
+        for (const ModelInfo& info : ListModels()) {
+            if (!given_model.empty() && info.name != given_model) continue;
+            for (const ModelOptionSpec& spec : info.options) {
+                if (arg.substr(2) == spec.name) {
+                    return " (model options are part of the model: --model " + info.name + ":" +
+                           spec.name + "=VALUE; `atmos list " + info.name + "` prints them)";
+                }
+            }
+        }
+    }
+    return "";
+}
+
 }  // namespace atmos

@@ -13,4 +13,10 @@ namespace atmos {
 // the validity domain.
 std::string ModelCapabilitiesText(const ModelInfo& info);
 
+// For a command line whose extra arguments CLI11 refused: when one is a model
+// option written as a flag (`--orders 2`, the syntax before issue 14), the hint
+// " (model options are part of the model: --model NAME:OPTION=VALUE; ...)";
+// else "". `args` are the arguments after the program name.
+std::string ModelOptionFlagHint(const std::vector<std::string>& args);
+
 }  // namespace atmos

@@ -189,13 +189,16 @@ Error RenameInMessage(const Error& e, const std::string& temporary, const std::s
 // The first entry under `dir` that is not a table, JSON, shader or viewer
 // page (what bake and viewer write), else "".
 std::string ForeignEntry(const std::filesystem::path& dir, int depth) {
-    static const char* const kWritten[] = {".exr",  ".json", ".glsl", ".js",
-                                           ".html", ".f32",  ".f16",  ".bin"};
+    // Tables, JSON, GLSL, viewer pages, raw blobs; the engine stages and their
+    // translations (shaders/{vulkan,spirv,hlsl,msl}/) and KTX2 files (ktx2/).
+    static const char* const kWritten[] = {".exr",  ".json", ".glsl", ".js",    ".html",
+                                           ".f32",  ".f16",  ".bin",  ".vert",  ".frag",
+                                           ".comp", ".spv",  ".hlsl", ".metal", ".ktx2"};
     std::error_code ec;
     for (const std::filesystem::directory_entry& e : std::filesystem::directory_iterator(dir, ec)) {
         const std::filesystem::file_status st = e.symlink_status(ec);
         if (std::filesystem::is_directory(st)) {
-            if (depth >= 2) return e.path().string();
+            if (depth >= 3) return e.path().string();  // viewer/MODEL/shaders/vulkan
             const std::string inner = ForeignEntry(e.path(), depth + 1);
             if (!inner.empty()) return inner;
             continue;

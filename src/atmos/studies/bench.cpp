@@ -1,6 +1,8 @@
 // atmos studies: the bench study (bench.h).
 #include "studies/bench.h"
 
+#include <filesystem>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdarg>
@@ -14,6 +16,7 @@
 #include "atmos/view.h"
 #include "base/parallel.h"
 #include "harness/machine.h"
+#include "io/output_path.h"
 #include "render/stages.h"
 #include "studies/common.h"
 
@@ -376,6 +379,13 @@ std::string BenchSpectralText(const BenchSpectralRow& r) {
         "prepare %8.3f s (x%.1f) render %8.3f s (x%.1f)\n",
         r.model.c_str(), r.view.c_str(), a, b, r.wavelengths, c, a > 0 ? c / a : 0.0, d,
         b > 0 ? d / b : 0.0);
+}
+
+std::string BenchStagesPath(const std::string& output, const std::string& stages_output) {
+    if (!stages_output.empty()) return stages_output;
+    if (IsStreamOutput(output)) return "";
+    const std::filesystem::path p(output);
+    return (p.parent_path() / (p.stem().string() + "_stages.csv")).string();
 }
 
 }  // namespace atmos

@@ -119,4 +119,8 @@ std::string BenchRowText(const BenchRow& row);
 std::string BenchStageText(const BenchStage& stage);
 std::string BenchSpectralText(const BenchSpectralRow& row);
 
+// Where the stages CSV goes: `stages_output` when given, else beside `output`
+// (STEM_stages.csv), or "" when `output` is a stream (/dev/null, stdout, a FIFO).
+std::string BenchStagesPath(const std::string& output, const std::string& stages_output);
+
 }  // namespace atmos
