@@ -27,6 +27,8 @@ struct GreyOptions {
 };
 
 struct GreyEvaluator {
+    // Test-only: not in models/model_list.h, so no CUDA kernel is instantiated for it.
+    static constexpr bool kHostOnly = true;
     float level = 0.25f;
     ATMOS_HD RayResult Evaluate(const Vec3d&, const Vec3d&, const Vec3d&, bool) const {
         RayResult r;
