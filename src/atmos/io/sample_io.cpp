@@ -13,6 +13,7 @@
 #include "atmos/error.h"
 #include "atmos/number.h"
 #include "io/bounded_read.h"
+#include "io/csv_fields.h"
 #include "io/image_formats.h"
 #include "io/output_path.h"
 
@@ -29,12 +30,6 @@ double ParseField(std::string_view text, int line, const char* column) {
     if (e != NumberError::kNone)
         Fail("line ", line, ": ", column, " '", std::string(text), "' ", NumberErrorText(e));
     return v;
-}
-
-std::string_view Trim(std::string_view s) {
-    const size_t b = s.find_first_not_of(" \t");
-    if (b == std::string_view::npos) return {};
-    return s.substr(b, s.find_last_not_of(" \t") - b + 1);
 }
 
 // The range checks of a query (`where`: "line N" or "row N").
@@ -74,16 +69,7 @@ std::vector<SampleQuery> ParseQueriesCsv(std::string_view text) {
             continue;
         }
         std::string_view fields[4];
-        size_t count = 0;
-        std::string_view rest = line;
-        for (;;) {
-            const size_t comma = rest.find(',');
-            if (count < 4) fields[count] = Trim(rest.substr(0, comma));
-            ++count;
-            if (comma == std::string_view::npos) break;
-            rest = rest.substr(comma + 1);
-            if (rest.empty()) break;  // a trailing comma adds no field
-        }
+        const size_t count = SplitCsvFields(line, fields, 4, /*trailing_comma_ends=*/true);
         if (count != 4) {
             Fail("line ", line_number, ": expected 4 comma-separated numbers, got ", count,
                  " fields");

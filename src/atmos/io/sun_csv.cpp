@@ -8,18 +8,13 @@
 
 #include "atmos/error.h"
 #include "atmos/number.h"
+#include "io/csv_fields.h"
 
 namespace atmos {
 
 namespace {
 
 constexpr char kHeader[] = "time,latitude,longitude";
-
-std::string_view TrimField(std::string_view s) {
-    const size_t b = s.find_first_not_of(" \t");
-    if (b == std::string_view::npos) return {};
-    return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
 
 struct Row {
     std::string time, latitude, longitude;  // as given (trimmed), echoed
@@ -54,15 +49,7 @@ std::vector<Row> ParseRows(std::string_view text, double height_m) {
         ++row_number;
         const std::string where = "row " + std::to_string(row_number);
         std::string_view fields[3];
-        size_t count = 0;
-        std::string_view rest = line;
-        for (;;) {
-            const size_t comma = rest.find(',');
-            if (count < 3) fields[count] = TrimField(rest.substr(0, comma));
-            ++count;
-            if (comma == std::string_view::npos) break;
-            rest = rest.substr(comma + 1);
-        }
+        const size_t count = SplitCsvFields(line, fields, 3, /*trailing_comma_ends=*/false);
         if (count != 3) {
             Fail(where, ": expected 3 comma-separated fields (", kHeader, "), got ", count);
         }
