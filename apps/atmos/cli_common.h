@@ -90,6 +90,7 @@ struct Command {
 // Registration functions, one per subcommand file.
 Command AddListCommand(CLI::App* root);
 Command AddRenderCommand(CLI::App* root);
+Command AddMergeCommand(CLI::App* root);
 Command AddSampleCommand(CLI::App* root);
 Command AddIrradianceCommand(CLI::App* root);
 Command AddBakeCommand(CLI::App* root);

@@ -1,4 +1,6 @@
 // atmos CLI: `atmos render`.
+#include <nlohmann/json.hpp>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +21,9 @@
 #include "harness/gallery.h"
 #include "harness/spectral_run.h"
 #include "io/output_path.h"
+#include "mpi_world.h"
+#include "render/progressive.h"
+#include "render/shards.h"
 
 namespace fs = std::filesystem;
 
@@ -40,9 +45,38 @@ struct RenderOptions {
     bool resume = false;
     bool keep_checkpoint = false;
     double checkpoint_every = 10.0;  // seconds between checkpoints, at most
+    std::string shard;               // --shard K/N (issue 36)
     MonteCarloFlags monte_carlo;
     SpectralFlags spectral;
 };
+
+// --shard K/N: K and N (1 <= K <= N); one error naming the flag otherwise.
+void ParseShard(const std::string& text, int64_t* index, int64_t* count) {
+    const size_t slash = text.find('/');
+    long long k = 0, n = 0;
+    size_t used_k = 0, used_n = 0;
+    bool ok = slash != std::string::npos && slash > 0 && slash + 1 < text.size();
+    try {
+        if (ok) {
+            k = std::stoll(text.substr(0, slash), &used_k);
+            n = std::stoll(text.substr(slash + 1), &used_n);
+        }
+    } catch (const std::exception&) {
+        ok = false;
+    }
+    ok = ok && used_k == slash && used_n == text.size() - slash - 1 && n >= 1 && n <= 1000000 &&
+         k >= 1 && k <= n;
+    if (!ok) {
+        Fail("--shard must be K/N with 1 <= K <= N <= 1000000 (shard K of N, e.g. 2/8), got '",
+             text, "'");
+    }
+    *index = k - 1;
+    *count = n;
+}
+
+bool EndsWith(const std::string& s, const std::string& tail) {
+    return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
 
 // --wavelengths: the views rendered at each wavelength (harness/spectral_run.h);
 // OUTPUT gets the colour (--colour, --white), STEM.spectral.exr the spectrum.
@@ -116,9 +150,45 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         CheckCameraSpec(camera_spec, width, height);
         sun_direction = ParseSunSpec(ro.sun);
     }
-    if (!all_views) ImageFormatFromPath(ro.output);  // fail before the work on a bad name
-    // The output is writable before any work (io/output_path.h).
-    if (all_views) {
+    // --shard K/N (or the ranks of mpirun): the passes of one Monte Carlo
+    // radiance render, split (render/shards.h).
+    const bool sharded = !ro.shard.empty();
+    int64_t shard_index = 0, shard_count = 1;
+    const MpiWorld& world = World();
+    if (sharded) {
+        ParseShard(ro.shard, &shard_index, &shard_count);
+        if (world.size > 1) {
+            Fail("--shard cannot be combined with mpirun (the ranks are the shards)");
+        }
+        if (all_views) Fail("--shard renders one view: give --view NAME, not --view all");
+        if (!EndsWith(ro.output, ".shard") && !IsStreamOutput(ro.output)) {
+            Fail("--shard writes the shard's passes, not an image: -o must end in .shard (got '",
+                 ro.output, "'); `atmos merge` makes the image");
+        }
+    } else if (EndsWith(ro.output, ".shard")) {
+        Fail("-o ", ro.output, ": a .shard output needs --shard K/N");
+    }
+    const bool split = sharded || world.size > 1;
+    if (split && !ro.spectral.wavelengths.empty()) {
+        Fail(sharded ? "--shard" : "mpirun",
+             " splits RGB renders only; --wavelengths cannot be split (yet)");
+    }
+    if (split && quantity != Quantity::kRadiance) {
+        Fail(sharded ? "--shard" : "mpirun",
+             " splits the passes of a Monte Carlo radiance render; --quantity ", ro.quantity,
+             " is not one");
+    }
+    if (split && ro.monte_carlo.noise_flag && ro.monte_carlo.noise_flag->count() > 0) {
+        Fail(sharded ? "--shard" : "mpirun",
+             " splits a render of a fixed --spp; --noise (a target reached by rendering until "
+             "it holds) cannot be split");
+    }
+    if (!all_views && !sharded)
+        ImageFormatFromPath(ro.output);  // fail before the work on a bad name
+    // The output is writable before any work (io/output_path.h); under
+    // mpirun rank 0 writes it.
+    if (world.rank != 0) {
+    } else if (all_views) {
         CheckOutputDirectory(ro.output);
     } else {
         CheckOutputFile(ro.output);
@@ -140,6 +210,10 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     const AtmosphereParameters atmosphere = LoadAtmosphere(common.atmosphere, common.sets);
     std::unique_ptr<Model> model = CreateModel(GivenModel(common));
     RequireQuantity(model->Info(), quantity);
+    if (split && !model->Info().capabilities.stochastic) {
+        Fail(sharded ? "--shard" : "mpirun", " splits the passes of a Monte Carlo model; model ",
+             model->Info().name, " is not one (`atmos list` marks them)");
+    }
     MonteCarloSettings monte_carlo = ro.monte_carlo.Settings(model->Info());
     monte_carlo.checkpoint_seconds = ro.checkpoint_every;
     std::vector<View> views;
@@ -155,17 +229,23 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         if (all_views) fs::create_directories(ro.output);
         return RenderSpectralViews(common, ro, views, width, height, quantity, monte_carlo);
     }
+    // Under mpirun only rank 0 reports.
+    const bool quiet = common.quiet || world.rank != 0;
     const double prepare_seconds = PrepareModel(common, atmosphere, model.get());
-    if (!common.quiet && prepare_seconds > 0.01) {
+    if (!quiet && prepare_seconds > 0.01) {
         std::fprintf(stderr, "prepared %s in %.3f s\n", common.model.c_str(), prepare_seconds);
     }
 
     std::vector<GalleryEntry> gallery;
-    if (all_views) fs::create_directories(ro.output);
+    if (all_views && world.rank == 0) fs::create_directories(ro.output);
     for (const View& view : views) {
         RenderRequest request = ViewRequest(view, width, height, quantity, monte_carlo);
         request.sun_disc = ro.sun_disc;
-        request.show_progress = !common.quiet;
+        request.show_progress = !quiet;
+        MonteCarloShard shard;
+        shard.index = sharded ? shard_index : world.rank;
+        shard.count = sharded ? shard_count : world.size;
+        const ShardScope shard_scope(split ? &shard : nullptr);
         const bool stochastic = model->Info().capabilities.stochastic;
         Image variance;
         MonteCarloReport report;
@@ -178,6 +258,11 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
             request.checkpoint = ro.checkpoint.empty() ? out_stem + ".ckpt"
                                  : all_views           ? ro.checkpoint + "-" + view.name
                                                        : ro.checkpoint;
+            // Under mpirun each rank checkpoints its own passes.
+            if (world.size > 1) {
+                request.checkpoint +=
+                    ".rank-" + std::to_string(world.rank + 1) + "-of-" + std::to_string(world.size);
+            }
             request.resume = ro.resume;
             if (!stream_output) request.variance = &variance;
             if (stream_output && ro.checkpoint.empty()) request.checkpoint.clear();
@@ -185,10 +270,53 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         Image image;
         const auto start = std::chrono::steady_clock::now();
         model->Render(request, &image);
-        const double seconds = Seconds(start);
+        double seconds = Seconds(start);
         const float exposure = ro.exposure > 0.0f                ? ro.exposure
                                : quantity == Quantity::kRadiance ? view.exposure
                                                                  : 1.0f;
+        auto drop_checkpoint = [&]() {
+            // The output is written: its checkpoint has done its job (issue 18 item 10).
+            if (!request.checkpoint.empty() && !ro.keep_checkpoint) {
+                std::error_code ignored;
+                fs::remove(request.checkpoint + ".bin", ignored);
+            }
+        };
+        if (sharded) {
+            // The shard's passes and the render's fingerprint (render/shards.h).
+            ShardFile file;
+            file.shard = std::move(shard);
+            nlohmann::json extra;
+            extra["view"] = view.name;
+            extra["exposure"] = exposure;
+            extra["seconds"] = seconds;
+            file.extra = extra.dump();
+            WriteFileAtomically(ro.output, SerializeShardFile(file));
+            drop_checkpoint();
+            if (!quiet) {
+                std::fprintf(stderr,
+                             "rendered shard %s of %-22s %dx%d with %s (%zu of %lld passes) in "
+                             "%.3f s (%d threads)\n",
+                             ro.shard.c_str(), view.name.c_str(), width, height,
+                             common.model.c_str(), file.shard.pass_images.size(),
+                             static_cast<long long>(file.shard.passes), seconds,
+                             ParallelThreadCount());
+            }
+            continue;
+        }
+        if (world.size > 1) {
+            // Every rank's passes to rank 0, merged there in pass order.
+            std::vector<MonteCarloShard> shards = GatherShards(std::move(shard));
+            drop_checkpoint();
+            if (world.rank != 0) continue;
+            std::vector<ShardFile> files(shards.size());
+            std::vector<std::string> names;
+            for (size_t r = 0; r < shards.size(); ++r) {
+                files[r].shard = std::move(shards[r]);
+                names.push_back("rank " + std::to_string(r));
+            }
+            MergeShards(files, names, &image, request.variance, &report);
+            seconds = Seconds(start);
+        }
         if (all_views) {
             const std::string stem = common.model + "-" + view.name;
             WriteImage(image, (fs::path(ro.output) / (stem + ".png")).string(), exposure);
@@ -199,25 +327,24 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
             WriteImage(image, ro.output, exposure);
         }
         if (!variance.empty()) WriteImage(variance, out_stem + ".variance.exr");
-        // The image is written: its checkpoint has done its job (issue 18 item 10).
-        if (!request.checkpoint.empty() && !ro.keep_checkpoint) {
-            std::error_code ignored;
-            fs::remove(request.checkpoint + ".bin", ignored);
-        }
-        if (!common.quiet && report.noise >= 0.0) {
+        drop_checkpoint();
+        if (!quiet && report.noise >= 0.0) {
             std::fprintf(stderr,
                          "%s: noise %.4f (HDR-FLIP between its halves) at %lld paths per "
                          "pixel%s\n",
                          view.name.c_str(), report.noise, static_cast<long long>(report.samples),
                          report.noise <= monte_carlo.noise_target ? "" : " (the --spp cap)");
         }
-        if (!common.quiet) {
-            std::fprintf(stderr, "rendered %-22s %dx%d with %s in %.3f s (%d threads)\n",
+        if (!quiet) {
+            std::fprintf(stderr, "rendered %-22s %dx%d with %s in %.3f s (%d threads%s)\n",
                          view.name.c_str(), width, height, common.model.c_str(), seconds,
-                         ParallelThreadCount());
+                         ParallelThreadCount(),
+                         world.size > 1
+                             ? (" per rank, " + std::to_string(world.size) + " MPI ranks").c_str()
+                             : "");
         }
     }
-    if (all_views) {
+    if (all_views && world.rank == 0) {
         const ModelInfo& info = model->Info();
         const std::string page = (fs::path(ro.output) / "index.html").string();
         WriteGalleryHtml(page, "atmos: " + info.title,
@@ -225,7 +352,7 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
                              common.atmosphere + ", " + ro.size + ", " + ro.quantity +
                              "; PNG: exposure, 1 - exp(-x), sRGB",
                          gallery);
-        if (!common.quiet) std::fprintf(stderr, "wrote %s\n", page.c_str());
+        if (!quiet) std::fprintf(stderr, "wrote %s\n", page.c_str());
     }
     return 0;
 }
@@ -276,6 +403,10 @@ Command AddRenderCommand(CLI::App* root) {
         ->capture_default_str();
     render->add_flag("--resume", ro->resume,
                      "Monte Carlo models: continue from the checkpoint of the same render");
+    render->add_option("--shard", ro->shard,
+                       "Monte Carlo models: render only shard K of N (K/N: the passes p with p "
+                       "mod N = K - 1) and write its passes to -o FILE.shard; `atmos merge` "
+                       "makes the image one process would have made (docs/scale-out.md)");
     AddMonteCarloFlags(render, &ro->monte_carlo, true);
     AddSpectralFlags(render, &ro->spectral);
     c.app = render;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <memory>
 #include <new>
 #include <string>
 #include <vector>
@@ -14,8 +15,11 @@
 #include "atmos/error.h"
 #include "cli_common.h"
 #include "harness/listing.h"
+#include "mpi_world.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int RunCommand(int argc, char** argv) {
     using namespace atmos::cli;
     CLI::App app{
         "atmos: atmospheric scattering models, a path-traced reference and their comparison"};
@@ -24,6 +28,7 @@ int main(int argc, char** argv) {
     const std::vector<Command> commands = {
         AddListCommand(&app),
         AddRenderCommand(&app),
+        AddMergeCommand(&app),
         AddSampleCommand(&app),
         AddIrradianceCommand(&app),
         AddBakeCommand(&app),
@@ -113,4 +118,21 @@ int main(int argc, char** argv) {
         return 2;
     }
     return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    // Under an MPI launcher (mpirun, srun): MPI for the process's life; a
+    // failure on one rank ends them all (mpi_world.h).
+    std::unique_ptr<atmos::cli::MpiSession> mpi;
+    try {
+        mpi = std::make_unique<atmos::cli::MpiSession>(&argc, &argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "atmos: error: %s\n", e.what());
+        return 2;
+    }
+    const int status = RunCommand(argc, argv);
+    if (status != 0) mpi->Abort(status);
+    return status;
 }

@@ -24,6 +24,7 @@
 #include "io/output_path.h"
 #include "metrics/flip.h"
 #include "render/render.h"
+#include "render/shards.h"
 
 namespace atmos {
 
@@ -94,6 +95,40 @@ nlohmann::json CheckpointKey(const Model& model, const RenderRequest& request, i
     return key;
 }
 
+// A shard's fingerprint: what fixes the whole render's passes (the checkpoint
+// key's fields and the paths per pixel), the same for each of its shards.
+nlohmann::json ShardFingerprint(const Model& model, const RenderRequest& request,
+                                int64_t pass_spp) {
+    nlohmann::json key = CheckpointKey(model, request, pass_spp);
+    key["format"] = "atmos-shard-1";
+    key["spp"] = request.monte_carlo.spp;
+    key["wavelengths"] = "rgb";  // the atmosphere's three channels (no spectral shards)
+    return key;
+}
+
+// Reads the checkpoint of a shard in progress (a shard file with its pass in
+// progress) and checks that it is this shard's.
+ShardFile ReadShardCheckpoint(const std::string& path, const ShardFile& expected) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(std::filesystem::status(path, ec))) {
+        Fail("checkpoint '", path,
+             "' is not a regular file (a directory, FIFO, device or socket); remove it or give "
+             "another --checkpoint");
+    }
+    std::ifstream f(path, std::ios::binary);
+    if (!f) Fail("cannot read checkpoint '", path, "'");
+    const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    ShardFile file = ParseShardFile(bytes, "checkpoint '" + path + "'");
+    if (nlohmann::json::parse(file.shard.fingerprint) !=
+            nlohmann::json::parse(expected.shard.fingerprint) ||
+        file.shard.index != expected.shard.index || file.shard.count != expected.shard.count) {
+        Fail("checkpoint '", path,
+             "' was made for a different render or shard (model, view, size, seed, spp, "
+             "atmosphere, pass size, options or --shard differ); remove it or drop --resume");
+    }
+    return file;
+}
+
 // A checkpoint is one file, STEM.bin, committed atomically: written to a
 // temporary created exclusively beside it (.STEM.bin.tmp-RANDOM), fsync'ed, renamed over STEM.bin,
 // its directory fsync'ed. A kill at any point leaves the previous checkpoint (or none) intact.
@@ -138,6 +173,8 @@ void WriteAll(int fd, const std::string& bytes, const std::string& path) {
     }
 }
 
+void CommitCheckpoint(const std::string& path, const std::string& bytes);
+
 void WriteCheckpoint(const std::string& path, const nlohmann::json& key,
                      const CheckpointState& state) {
     nlohmann::json header;
@@ -164,7 +201,11 @@ void WriteCheckpoint(const std::string& path, const nlohmann::json& key,
     }
     const uint64_t checksum = Fnv1a(bytes.data(), bytes.size());
     bytes.append(reinterpret_cast<const char*>(&checksum), sizeof checksum);
+    CommitCheckpoint(path, bytes);
+}
 
+// `bytes` to the checkpoint `path`: a temporary, fsync, rename, the directory's fsync.
+void CommitCheckpoint(const std::string& path, const std::string& bytes) {
     // The checkpoint's directory is the user's (checked before the work:
     // atmos creates none); the temporary is created exclusively beside it, so
     // a link planted under a predictable name cannot redirect the write.
@@ -316,6 +357,38 @@ CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& ke
 
 }  // namespace
 
+void AccumulatePass(float* sum, float* sum_sq, float* sum_even, const float* v, size_t count,
+                    float weight) {
+    for (size_t i = 0; i < count; ++i) {
+        sum[i] += weight * v[i];
+        sum_sq[i] += weight * v[i] * v[i];
+        if (sum_even) sum_even[i] += weight * v[i];
+    }
+}
+
+void FinishMonteCarlo(const Image& sum, const Image& sum_sq, int64_t samples_done,
+                      int64_t passes_done, Image* out, Image* variance) {
+    // Mean, and the variance of the mean from the pass means (batch means):
+    // Var(mean) = (E[v^2] - mean^2) / (passes - 1), weights by sample count.
+    const size_t n = sum.size();
+    if (variance) variance->Resize(sum.width(), sum.height());
+    const float inv = 1.0f / static_cast<float>(std::max<int64_t>(samples_done, 1));
+    for (size_t i = 0; i < n; ++i) {
+        const float mean = sum.data()[i] * inv;
+        out->data()[i] = mean;
+        if (variance) {
+            const float second = sum_sq.data()[i] * inv;
+            const float var = passes_done > 1 ? std::max(second - mean * mean, 0.0f) /
+                                                    static_cast<float>(passes_done - 1)
+                                              : 0.0f;
+            variance->data()[i] = var;
+        }
+    }
+    // The mean (also one read back by --resume) goes through the output guard.
+    GuardOutput(out->data(), n);
+    if (variance) GuardOutput(variance->data(), n);
+}
+
 int64_t PassSpp(const MonteCarloSettings& mc) {
     if (mc.pass_spp > 0) return mc.pass_spp;
     if (mc.noise_target > 0.0) return std::clamp<int64_t>(mc.spp / 2, 1, 16);
@@ -353,6 +426,24 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     RequireMonteCarlo(model);
     const MonteCarloSettings& mc = request.monte_carlo;
     CheckSettings(mc);
+    MonteCarloShard* const shard = CurrentShard();
+    if (shard) {
+        if (shard->count < 1 || shard->index < 0 || shard->index >= shard->count) {
+            Fail("Monte Carlo render: shard ", shard->index + 1, "/", shard->count,
+                 " is out of range (K/N with 1 <= K <= N)");
+        }
+        if (request.quantity != Quantity::kRadiance) {
+            Fail(
+                "a shard (--shard) holds passes of a radiance render; a transmittance render "
+                "is one deterministic pass");
+        }
+        if (mc.noise_target > 0.0) {
+            Fail(
+                "a shard (--shard) holds passes of a render of a fixed --spp; a noise target "
+                "(--noise) cannot be split into shards (`atmos merge` reports the merged "
+                "paths per pixel; render more with a larger --spp)");
+        }
+    }
     if (request.quantity == Quantity::kTransmittance) {
         Progress progress(model.Info().name, static_cast<int64_t>(request.width) * request.height,
                           request.show_progress);
@@ -374,11 +465,25 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     if (noise_mode) passes = std::max<int64_t>(2, passes + (passes & 1));
     out->Resize(request.width, request.height);
     const size_t n = out->size();
+    // The passes this run renders, in order: all of them, or a shard's.
+    const std::vector<int64_t> order =
+        shard ? ShardPasses(passes, shard->index, shard->count) : ShardPasses(passes, 0, 1);
+    const int64_t run_passes = static_cast<int64_t>(order.size());
+    // A shard keeps each pass's mean (render/shards.h) instead of the sums.
+    ShardFile shard_file;
+    if (shard) {
+        shard_file.shard.index = shard->index;
+        shard_file.shard.count = shard->count;
+        shard_file.shard.fingerprint = ShardFingerprint(model, request, pass_spp).dump();
+        shard_file.shard.passes = passes;
+        shard_file.shard.width = request.width;
+        shard_file.shard.height = request.height;
+    }
 
     const std::string stem = request.checkpoint;
     const std::string path = stem + ".bin";
     const nlohmann::json key =
-        stem.empty() ? nlohmann::json() : CheckpointKey(model, request, pass_spp);
+        stem.empty() || shard ? nlohmann::json() : CheckpointKey(model, request, pass_spp);
     // One run per checkpoint: a second run on it fails here, before any pass.
     const FileLock lock(stem.empty() ? std::string() : path);
     // Its place holds a checkpoint or nothing: a directory, a FIFO or a device
@@ -388,7 +493,17 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     state.sum.Resize(request.width, request.height);
     state.sum_sq.Resize(request.width, request.height);
     if (noise_mode) state.sum_even.Resize(request.width, request.height);
-    if (!stem.empty() && request.resume) {
+    if (!stem.empty() && request.resume && shard) {
+        if (std::filesystem::exists(path)) {
+            shard_file = ReadShardCheckpoint(path, shard_file);
+            state.passes_done = static_cast<int64_t>(shard_file.shard.pass_images.size());
+            for (const MonteCarloPassImage& done : shard_file.shard.pass_images) {
+                state.samples_done += done.samples;
+            }
+            state.rows_done = shard_file.rows_done;
+            state.pass_samples = shard_file.rows_done > 0 ? shard_file.partial.samples : 0;
+        }
+    } else if (!stem.empty() && request.resume) {
         if (std::filesystem::exists(path)) {
             state = ReadCheckpoint(path, key, request.width, request.height,
                                    noise_mode ? passes * pass_spp : spp, pass_spp, noise_mode);
@@ -403,12 +518,18 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     int64_t& passes_done = state.passes_done;
     int64_t& samples_done = state.samples_done;
     auto save_checkpoint = [&]() {
-        if (!stem.empty()) WriteCheckpoint(path, key, state);
+        if (stem.empty()) return;
+        if (shard) {
+            shard_file.rows_done = state.rows_done;
+            CommitCheckpoint(path, SerializeShardFile(shard_file));
+        } else {
+            WriteCheckpoint(path, key, state);
+        }
     };
 
     const int64_t pixels = static_cast<int64_t>(request.width) * request.height;
     Progress progress(model.Info().name,
-                      pixels * std::max<int64_t>(passes - passes_done, 1) -
+                      pixels * std::max<int64_t>(run_passes - passes_done, 1) -
                           static_cast<int64_t>(state.rows_done) * request.width,
                       request.show_progress);
     const StopSignalScope stop(!stem.empty());
@@ -456,7 +577,8 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
                                           : std::clamp(16384 / std::max(width, 1), 1, height);
     auto last_save = Clock::now();
     Image band_image;
-    for (int64_t p = passes_done; p < passes && !reached; ++p) {
+    for (int64_t k = passes_done; k < run_passes && !reached; ++k) {
+        const int64_t p = order[static_cast<size_t>(k)];
         MonteCarloPass pass;
         pass.seed = mc.seed;
         pass.first_sample = p * pass_spp;
@@ -465,6 +587,12 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
                                            : std::min(pass_spp, spp - pass.first_sample);
         // Weighted by the pass's sample count so a short last pass counts right.
         const float wgt = static_cast<float>(pass.samples);
+        if (shard) {
+            shard_file.partial.index = p;
+            shard_file.partial.samples = pass.samples;
+            // A new pass (else the resumed pass's rows done are kept).
+            if (state.rows_done == 0) shard_file.partial.mean.Resize(width, height);
+        }
         int signal_number = 0;
         for (int row = state.rows_done; row < height;) {
             pass.row_begin = row;
@@ -478,12 +606,13 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
             }
             const size_t first = static_cast<size_t>(row) * static_cast<size_t>(width) * 3;
             const size_t count = static_cast<size_t>(pass.rows) * static_cast<size_t>(width) * 3;
-            for (size_t j = 0; j < count; ++j) {
-                const size_t i = first + j;
-                const float v = band_image.data()[j];
-                sum.data()[i] += wgt * v;
-                sum_sq.data()[i] += wgt * v * v;
-                if (noise_mode && p % 2 == 0) state.sum_even.data()[i] += wgt * v;
+            if (shard) {
+                std::copy(band_image.data(), band_image.data() + count,
+                          shard_file.partial.mean.data() + first);
+            } else {
+                AccumulatePass(sum.data() + first, sum_sq.data() + first,
+                               noise_mode && p % 2 == 0 ? state.sum_even.data() + first : nullptr,
+                               band_image.data(), count, wgt);
             }
             row += pass.rows;
             const auto now = Clock::now();
@@ -505,38 +634,45 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
                 last_save = Clock::now();
             }
             if (signal_number != 0) {
-                Fail("interrupted by ", StopSignalName(signal_number), " in pass ", p + 1, " of ",
-                     passes, " (", samples_done, " of ", spp, " samples per pixel and ", row,
+                Fail("interrupted by ", StopSignalName(signal_number), " in pass ", k + 1, " of ",
+                     run_passes, " (", samples_done, " of ", spp, " samples per pixel and ", row,
                      " of ", height, " rows of the next pass done); the checkpoint '", path,
                      "' holds them: the same command with --resume continues");
             }
         }
         state.rows_done = 0;
         state.pass_samples = 0;
+        if (shard) {
+            MonteCarloPassImage done;
+            done.index = p;
+            done.samples = pass.samples;
+            done.mean = shard_file.partial.mean;
+            shard_file.shard.pass_images.push_back(std::move(done));
+        }
         ++passes_done;
         samples_done += pass.samples;
         const bool pair_done = !noise_mode || p % 2 == 1;
-        if (noise_mode && pair_done && (samples_done >= next_check || p + 1 == passes)) {
+        if (noise_mode && pair_done && (samples_done >= next_check || k + 1 == run_passes)) {
             reached = measure_noise();
         }
         const auto now = Clock::now();
         signal_number = stop.Received();
-        if (signal_number != 0 || p + 1 == passes || reached ||
+        if (signal_number != 0 || k + 1 == run_passes || reached ||
             std::chrono::duration<double>(now - last_save).count() >= mc.checkpoint_seconds) {
             save_checkpoint();
             last_save = now;
         }
         if (request.on_pass) {
             try {
-                request.on_pass(passes_done, passes);
+                request.on_pass(passes_done, run_passes);
             } catch (...) {
                 save_checkpoint();  // keep the passes done
                 throw;
             }
         }
-        if (signal_number != 0 && p + 1 < passes && !reached) {
+        if (signal_number != 0 && k + 1 < run_passes && !reached) {
             Fail("interrupted by ", StopSignalName(signal_number), " after pass ", passes_done,
-                 " of ", passes, " (", samples_done, " of ", spp,
+                 " of ", run_passes, " (", samples_done, " of ", spp,
                  " samples per pixel); the checkpoint '", path,
                  "' holds them: the same command with --resume continues");
         }
@@ -545,24 +681,18 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
         request.report->samples = samples_done;
         request.report->noise = noise;
     }
-    // Mean, and the variance of the mean from the pass means (batch means):
-    // Var(mean) = (E[v^2] - mean^2) / (passes - 1), weights by sample count.
-    if (request.variance) request.variance->Resize(request.width, request.height);
-    const float inv = 1.0f / static_cast<float>(std::max<int64_t>(samples_done, 1));
-    for (size_t i = 0; i < n; ++i) {
-        const float mean = sum.data()[i] * inv;
-        out->data()[i] = mean;
-        if (request.variance) {
-            const float second = sum_sq.data()[i] * inv;
-            const float var = passes_done > 1 ? std::max(second - mean * mean, 0.0f) /
-                                                    static_cast<float>(passes_done - 1)
-                                              : 0.0f;
-            request.variance->data()[i] = var;
-        }
+    if (shard) {
+        // The shard's passes, not an image (MergeShards makes it).
+        shard_file.partial = MonteCarloPassImage();
+        const int64_t index = shard->index, count = shard->count;
+        *shard = std::move(shard_file.shard);
+        shard->index = index;
+        shard->count = count;
+        out->Resize(0, 0);
+        if (request.variance) request.variance->Resize(0, 0);
+        return;
     }
-    // The mean (also one read back by --resume) goes through the output guard.
-    GuardOutput(out->data(), n);
-    if (request.variance) GuardOutput(request.variance->data(), n);
+    FinishMonteCarlo(sum, sum_sq, samples_done, passes_done, out, request.variance);
 }
 
 }  // namespace atmos
