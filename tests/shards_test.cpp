@@ -22,6 +22,7 @@
 #include "atmos/model.h"
 #include "base/progress.h"
 #include "base/rng.h"
+#include "metrics/flip.h"
 #include "render/progressive.h"
 #include "render/shards.h"
 
@@ -152,6 +153,27 @@ TEST(Shards, MergedShardsAreTheOneProcessRenderForAnyCount) {
         EXPECT_TRUE(SameBytes(merged, one)) << count << " shards";
         EXPECT_TRUE(SameBytes(variance, one_variance)) << count << " shards";
         EXPECT_EQ(report.samples, 35);
+        // The noise: the HDR-FLIP between the even and the odd passes' means,
+        // here from the passes' images directly (in double).
+        std::vector<double> even(one.size(), 0.0), odd(one.size(), 0.0);
+        double even_w = 0.0, odd_w = 0.0;
+        for (const ShardFile& f : files) {
+            for (const MonteCarloPassImage& p : f.shard.pass_images) {
+                std::vector<double>& half = p.index % 2 == 0 ? even : odd;
+                (p.index % 2 == 0 ? even_w : odd_w) += static_cast<double>(p.samples);
+                for (size_t i = 0; i < one.size(); ++i) {
+                    half[i] +=
+                        static_cast<double>(p.samples) * static_cast<double>(p.mean.data()[i]);
+                }
+            }
+        }
+        Image a(one.width(), one.height()), b(one.width(), one.height());
+        for (size_t i = 0; i < one.size(); ++i) {
+            a.data()[i] = static_cast<float>(even[i] / even_w);
+            b.data()[i] = static_cast<float>(odd[i] / odd_w);
+        }
+        EXPECT_NEAR(report.noise, HdrFlip(a, b).mean, 1e-4) << count << " shards";
+        EXPECT_GT(report.noise, 0.0);
     }
 }
 

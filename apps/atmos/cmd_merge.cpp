@@ -56,6 +56,12 @@ int CmdMerge(const MergeOptions& o) {
                      files.size(), static_cast<long long>(files[0].shard.passes),
                      static_cast<long long>(report.samples), image.width(), image.height(),
                      o.output.c_str());
+        if (report.noise >= 0.0) {
+            std::fprintf(stderr,
+                         "noise %.4f (HDR-FLIP between the even and the odd passes' means, as "
+                         "render --noise measures it)\n",
+                         report.noise);
+        }
     }
     return 0;
 }

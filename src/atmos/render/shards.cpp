@@ -14,6 +14,7 @@
 
 #include "atmos/error.h"
 #include "io/bounded_read.h"
+#include "metrics/flip.h"
 #include "render/progressive.h"
 
 namespace atmos {
@@ -266,11 +267,19 @@ void MergeShards(const std::vector<ShardFile>& files, const std::vector<std::str
     // The sums in pass order, as the one-process render adds them.
     const int width = first.width, height = first.height;
     Image sum(width, height), sum_sq(width, height);
-    int64_t samples = 0;
+    // The even passes' sum too (apart: it does not touch the sums), for the
+    // noise between the halves.
+    Image sum_even(width, height), ignored(width, height);
+    int64_t samples = 0, even_samples = 0;
     for (int64_t p = 0; p < passes; ++p) {
         const MonteCarloPassImage& pass = *by_pass[static_cast<size_t>(p)];
         AccumulatePass(sum.data(), sum_sq.data(), nullptr, pass.mean.data(), sum.size(),
                        static_cast<float>(pass.samples));
+        if (p % 2 == 0) {
+            AccumulatePass(sum_even.data(), ignored.data(), nullptr, pass.mean.data(), sum.size(),
+                           static_cast<float>(pass.samples));
+            even_samples += pass.samples;
+        }
         samples += pass.samples;
     }
     out->Resize(width, height);
@@ -278,6 +287,18 @@ void MergeShards(const std::vector<ShardFile>& files, const std::vector<std::str
     if (report) {
         report->samples = samples;
         report->noise = -1.0;
+        if (passes >= 2) {
+            // The HDR-FLIP between the means of the even and the odd passes,
+            // the measure of `render --noise` (informational here).
+            Image a(width, height), b(width, height);
+            const float inv_even = 1.0f / static_cast<float>(even_samples);
+            const float inv_odd = 1.0f / static_cast<float>(samples - even_samples);
+            for (size_t i = 0; i < sum.size(); ++i) {
+                a.data()[i] = sum_even.data()[i] * inv_even;
+                b.data()[i] = std::max(sum.data()[i] - sum_even.data()[i], 0.0f) * inv_odd;
+            }
+            report->noise = HdrFlip(a, b).mean;
+        }
     }
 }
 

@@ -117,7 +117,9 @@ std::vector<int64_t> ShardPasses(int64_t passes, int64_t index, int64_t count);
 // another render (its fingerprint differs: the fields that differ are named),
 // or when a pass is missing or held twice. Then the image (and, where given,
 // the variance of its mean) exactly as the one-process render makes them;
-// report->samples gets the paths per pixel.
+// report->samples gets the paths per pixel and report->noise the HDR-FLIP
+// between the means of the even and the odd passes (the measure of a noise
+// target; -1 with one pass).
 void MergeShards(const std::vector<ShardFile>& files, const std::vector<std::string>& names,
                  Image* out, Image* variance, MonteCarloReport* report);
 
