@@ -106,10 +106,12 @@ bool SameBytes(const Image& a, const Image& b) {
 }
 
 // Shard `index` of `count` of `request`, as a file would hold it.
-ShardFile RenderShard(const Model& model, RenderRequest request, int64_t index, int64_t count) {
+ShardFile RenderShard(const Model& model, RenderRequest request, int64_t index, int64_t count,
+                      int64_t first_pass = 0) {
     ShardFile file;
     file.shard.index = index;
     file.shard.count = count;
+    file.shard.first_pass = first_pass;
     {
         const ShardScope scope(&file.shard);
         Image ignored;
@@ -202,14 +204,53 @@ TEST(Shards, MergeRefusesMissingDuplicateForeignAndUnfinishedShards) {
     EXPECT_NE(e.find("shard 'part2' is from another render than 'part0' (seed differ)"),
               std::string::npos)
         << e;
+    // Another pass size: foreign.
+    e = MergeError({files[0], files[1], RenderShard(model, DiceRequest(12, 3), 2, 3)});
+    EXPECT_NE(e.find("(pass_spp differ)"), std::string::npos) << e;
+    // More paths: the render of 14 (7 passes), whose last pass no shard holds.
     e = MergeError({files[0], files[1], RenderShard(model, DiceRequest(14, 2), 2, 3)});
-    EXPECT_NE(e.find("from another render"), std::string::npos) << e;
-    EXPECT_NE(e.find("spp"), std::string::npos) << e;
+    EXPECT_NE(e.find("1 of 7 passes are missing (pass 7 not given)"), std::string::npos) << e;
     // A shard with a pass short: unfinished (a checkpoint).
     ShardFile unfinished = files[1];
     unfinished.shard.pass_images.pop_back();
     e = MergeError({files[0], ParseShardFile(SerializeShardFile(unfinished), "x"), files[2]});
     EXPECT_NE(e.find("is unfinished"), std::string::npos) << e;
+}
+
+TEST(Shards, ALaterRoundExtendsTheRenderToTheOneProcessImageOfMorePaths) {
+    const DiceModel model;
+    // Round 1: 12 paths in passes of 3 (4 passes), two shards; then the
+    // render of 21 paths (7 passes): round 2, passes 5 to 7, in two shards.
+    std::vector<ShardFile> round1 = {RenderShard(model, DiceRequest(12, 3), 0, 2),
+                                     RenderShard(model, DiceRequest(12, 3), 1, 2)};
+    std::vector<ShardFile> round2 = {RenderShard(model, DiceRequest(21, 3), 0, 2, 4),
+                                     RenderShard(model, DiceRequest(21, 3), 1, 2, 4)};
+    EXPECT_EQ(round2[0].shard.pass_images.size(), 2u);  // passes 5 and 7
+    EXPECT_EQ(round2[1].shard.pass_images.size(), 1u);  // pass 6
+    for (const auto& [spp, files] :
+         {std::make_pair(12, round1),
+          std::make_pair(21, std::vector<ShardFile>{round2[1], round1[0], round2[0], round1[1]})}) {
+        RenderRequest request = DiceRequest(spp, 3);
+        Image one, one_variance;
+        request.variance = &one_variance;
+        model.Render(request, &one);
+        Image merged, variance;
+        MonteCarloReport report;
+        MergeShards(files, std::vector<std::string>(files.size(), "part"), &merged, &variance,
+                    &report);
+        EXPECT_TRUE(SameBytes(merged, one)) << spp;
+        EXPECT_TRUE(SameBytes(variance, one_variance)) << spp;
+        EXPECT_EQ(report.samples, spp);
+    }
+    // Round 2 without a shard: missing; round 1 of 11 paths (a short last
+    // pass of 2): not passes of the render of 21.
+    std::string e = MergeError({round1[0], round1[1], round2[0]});
+    EXPECT_NE(e.find("1 of 7 passes are missing (pass 6 not given)"), std::string::npos) << e;
+    e = MergeError({RenderShard(model, DiceRequest(11, 3), 0, 2),
+                    RenderShard(model, DiceRequest(11, 3), 1, 2), round2[0], round2[1]});
+    EXPECT_NE(e.find("pass 4 in 'part1' holds 2 paths per pixel (its render: --spp 11) but 3"),
+              std::string::npos)
+        << e;
 }
 
 TEST(Shards, ShardFilesRefuseDamage) {
@@ -358,6 +399,29 @@ TEST(Shards, CliThreeShardsMergeToTheOneProcessImage) {
             .status,
         0);
     EXPECT_EQ(FileBytes(dir / "merged.png"), FileBytes(dir / "one.png"));
+
+    // A later round: 4 more paths per pixel (passes 6 and 7) in two shards;
+    // merged with the first round, the render of 14 paths.
+    const std::string more =
+        "render -q --model reference --view ground-sunrise --size 16x8 --spp 14 --pass-spp 2 "
+        "--seed 7 ";
+    for (int k = 1; k <= 2; ++k) {
+        const std::string part = (dir / ("round2-" + std::to_string(k) + ".shard")).string();
+        r = RunCli(more + "--extend-from 10 --shard " + std::to_string(k) + "/2 -o " + part, dir);
+        ASSERT_EQ(r.status, 0) << r.err;
+    }
+    ASSERT_EQ(RunCli(more + "-o " + (dir / "one14.exr").string(), dir).status, 0);
+    r = RunCli("merge -q " + p1 + " " + (dir / "round2-2.shard").string() + " " + p2 + " " + p3 +
+                   " " + (dir / "round2-1.shard").string() + " -o " +
+                   (dir / "merged14.exr").string(),
+               dir);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(FileBytes(dir / "merged14.exr"), FileBytes(dir / "one14.exr"));
+    EXPECT_EQ(FileBytes(dir / "merged14.variance.exr"), FileBytes(dir / "one14.variance.exr"));
+    r = RunCli(more + "--extend-from 9 --shard 1/2 -o " + (dir / "x.shard").string(), dir);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--extend-from must be a multiple of --pass-spp 2"), std::string::npos)
+        << r.err;
 
     // Refusals: one line, exit 2, nothing written.
     auto refused = [&](const std::string& parts, const std::string& needle) {

@@ -46,6 +46,7 @@ struct RenderOptions {
     bool keep_checkpoint = false;
     double checkpoint_every = 10.0;  // seconds between checkpoints, at most
     std::string shard;               // --shard K/N (issue 36)
+    int64_t extend_from = 0;         // --extend-from SPP: a later round of shards
     MonteCarloFlags monte_carlo;
     SpectralFlags spectral;
 };
@@ -168,6 +169,19 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     } else if (EndsWith(ro.output, ".shard")) {
         Fail("-o ", ro.output, ": a .shard output needs --shard K/N");
     }
+    if (ro.extend_from != 0) {
+        // A later round: the passes after the first EXTEND paths per pixel.
+        const int64_t pass_spp = ro.monte_carlo.pass_spp;
+        if (!sharded) Fail("--extend-from needs --shard K/N (a later round of shards)");
+        if (pass_spp <= 0) {
+            Fail("--extend-from needs --pass-spp P (the same in every round: it fixes the passes)");
+        }
+        if (ro.extend_from < 0 || ro.extend_from % pass_spp != 0 ||
+            ro.extend_from >= ro.monte_carlo.spp) {
+            Fail("--extend-from must be a multiple of --pass-spp ", pass_spp, " below --spp ",
+                 ro.monte_carlo.spp, " (the earlier round's --spp), got ", ro.extend_from);
+        }
+    }
     const bool split = sharded || world.size > 1;
     if (split && !ro.spectral.wavelengths.empty()) {
         Fail(sharded ? "--shard" : "mpirun",
@@ -181,7 +195,8 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     if (split && ro.monte_carlo.noise_flag && ro.monte_carlo.noise_flag->count() > 0) {
         Fail(sharded ? "--shard" : "mpirun",
              " splits a render of a fixed --spp; --noise (a target reached by rendering until "
-             "it holds) cannot be split");
+             "it holds) cannot be split (`atmos merge` prints the noise reached; more paths: "
+             "a later round of shards, --extend-from, docs/scale-out.md)");
     }
     if (!all_views && !sharded)
         ImageFormatFromPath(ro.output);  // fail before the work on a bad name
@@ -245,6 +260,7 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         MonteCarloShard shard;
         shard.index = sharded ? shard_index : world.rank;
         shard.count = sharded ? shard_count : world.size;
+        if (ro.extend_from > 0) shard.first_pass = ro.extend_from / ro.monte_carlo.pass_spp;
         const ShardScope shard_scope(split ? &shard : nullptr);
         const bool stochastic = model->Info().capabilities.stochastic;
         Image variance;
@@ -407,6 +423,10 @@ Command AddRenderCommand(CLI::App* root) {
                        "Monte Carlo models: render only shard K of N (K/N: the passes p with p "
                        "mod N = K - 1) and write its passes to -o FILE.shard; `atmos merge` "
                        "makes the image one process would have made (docs/scale-out.md)");
+    render->add_option("--extend-from", ro->extend_from,
+                       "with --shard: a later round, only the passes after the first SPP paths "
+                       "per pixel (an earlier round's --spp, a multiple of --pass-spp); merge "
+                       "it with the earlier round's shards");
     AddMonteCarloFlags(render, &ro->monte_carlo, true);
     AddSpectralFlags(render, &ro->spectral);
     c.app = render;

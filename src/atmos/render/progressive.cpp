@@ -95,13 +95,14 @@ nlohmann::json CheckpointKey(const Model& model, const RenderRequest& request, i
     return key;
 }
 
-// A shard's fingerprint: what fixes the whole render's passes (the checkpoint
-// key's fields and the paths per pixel), the same for each of its shards.
+// A shard's fingerprint: what fixes the render's passes (the checkpoint key's
+// fields), the same for each of its shards and rounds; the paths per pixel
+// are the shard's own field (an earlier round's shards merge into a later
+// round's render, render/shards.h).
 nlohmann::json ShardFingerprint(const Model& model, const RenderRequest& request,
                                 int64_t pass_spp) {
     nlohmann::json key = CheckpointKey(model, request, pass_spp);
     key["format"] = "atmos-shard-1";
-    key["spp"] = request.monte_carlo.spp;
     key["wavelengths"] = "rgb";  // the atmosphere's three channels (no spectral shards)
     return key;
 }
@@ -121,7 +122,9 @@ ShardFile ReadShardCheckpoint(const std::string& path, const ShardFile& expected
     ShardFile file = ParseShardFile(bytes, "checkpoint '" + path + "'");
     if (nlohmann::json::parse(file.shard.fingerprint) !=
             nlohmann::json::parse(expected.shard.fingerprint) ||
-        file.shard.index != expected.shard.index || file.shard.count != expected.shard.count) {
+        file.shard.index != expected.shard.index || file.shard.count != expected.shard.count ||
+        file.shard.spp != expected.shard.spp ||
+        file.shard.first_pass != expected.shard.first_pass) {
         Fail("checkpoint '", path,
              "' was made for a different render or shard (model, view, size, seed, spp, "
              "atmosphere, pass size, options or --shard differ); remove it or drop --resume");
@@ -440,8 +443,8 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
         if (mc.noise_target > 0.0) {
             Fail(
                 "a shard (--shard) holds passes of a render of a fixed --spp; a noise target "
-                "(--noise) cannot be split into shards (`atmos merge` reports the merged "
-                "paths per pixel; render more with a larger --spp)");
+                "(--noise) cannot be split into shards (`atmos merge` reports the noise of the "
+                "merged passes; a later round, --extend-from, adds paths)");
         }
     }
     if (request.quantity == Quantity::kTransmittance) {
@@ -465,9 +468,14 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     if (noise_mode) passes = std::max<int64_t>(2, passes + (passes & 1));
     out->Resize(request.width, request.height);
     const size_t n = out->size();
+    if (shard && (shard->first_pass < 0 || shard->first_pass >= passes)) {
+        Fail("Monte Carlo render: a later round's first pass ", shard->first_pass + 1,
+             " is outside the render's ", passes, " passes");
+    }
     // The passes this run renders, in order: all of them, or a shard's.
     const std::vector<int64_t> order =
-        shard ? ShardPasses(passes, shard->index, shard->count) : ShardPasses(passes, 0, 1);
+        shard ? ShardPasses(passes, shard->index, shard->count, shard->first_pass)
+              : ShardPasses(passes, 0, 1);
     const int64_t run_passes = static_cast<int64_t>(order.size());
     // A shard keeps each pass's mean (render/shards.h) instead of the sums.
     ShardFile shard_file;
@@ -476,6 +484,8 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
         shard_file.shard.count = shard->count;
         shard_file.shard.fingerprint = ShardFingerprint(model, request, pass_spp).dump();
         shard_file.shard.passes = passes;
+        shard_file.shard.spp = spp;
+        shard_file.shard.first_pass = shard->first_pass;
         shard_file.shard.width = request.width;
         shard_file.shard.height = request.height;
     }
@@ -684,10 +694,7 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     if (shard) {
         // The shard's passes, not an image (MergeShards makes it).
         shard_file.partial = MonteCarloPassImage();
-        const int64_t index = shard->index, count = shard->count;
         *shard = std::move(shard_file.shard);
-        shard->index = index;
-        shard->count = count;
         out->Resize(0, 0);
         if (request.variance) request.variance->Resize(0, 0);
         return;

@@ -54,9 +54,9 @@ ShardScope::ShardScope(MonteCarloShard* shard) : previous_(t_shard) { t_shard = 
 ShardScope::~ShardScope() { t_shard = previous_; }
 MonteCarloShard* CurrentShard() { return t_shard; }
 
-std::vector<int64_t> ShardPasses(int64_t passes, int64_t index, int64_t count) {
+std::vector<int64_t> ShardPasses(int64_t passes, int64_t index, int64_t count, int64_t first_pass) {
     std::vector<int64_t> list;
-    for (int64_t p = index; p < passes; p += count) list.push_back(p);
+    for (int64_t p = first_pass + index; p < passes; p += count) list.push_back(p);
     return list;
 }
 
@@ -66,6 +66,8 @@ std::string SerializeShardFile(const ShardFile& file) {
     header["format"] = kShardFormat;
     header["fingerprint"] = nlohmann::json::parse(s.fingerprint);
     header["shard"] = {s.index, s.count};
+    header["first_pass"] = s.first_pass;
+    header["spp"] = s.spp;
     header["passes"] = s.passes;
     header["width"] = s.width;
     header["height"] = s.height;
@@ -107,15 +109,16 @@ ShardFile ParseShardFile(const std::string& bytes, const std::string& what) {
     }
     ShardFile file;
     MonteCarloShard& s = file.shard;
-    int64_t spp = 0, pass_spp = 0;
+    int64_t pass_spp = 0;
     std::vector<std::pair<int64_t, int64_t>> list;
     try {
         const nlohmann::json header = nlohmann::json::parse(bytes.substr(16, header_size));
         if (header.at("format") != kShardFormat) bad("format is not " + std::string(kShardFormat));
         const nlohmann::json& fp = header.at("fingerprint");
         s.fingerprint = fp.dump();
-        spp = fp.at("spp").get<int64_t>();
         pass_spp = fp.at("pass_spp").get<int64_t>();
+        s.spp = header.at("spp").get<int64_t>();
+        s.first_pass = header.at("first_pass").get<int64_t>();
         s.index = header.at("shard").at(0).get<int64_t>();
         s.count = header.at("shard").at(1).get<int64_t>();
         s.passes = header.at("passes").get<int64_t>();
@@ -135,13 +138,15 @@ ShardFile ParseShardFile(const std::string& bytes, const std::string& what) {
     } catch (const nlohmann::json::exception&) {
         bad("unreadable or incomplete header");
     }
+    const int64_t spp = s.spp;
     if (spp < 1 || pass_spp < 1 || s.passes != (spp + pass_spp - 1) / pass_spp) {
         bad("its pass count disagrees with its spp and pass size");
     }
+    if (s.first_pass < 0 || s.first_pass >= s.passes) bad("its first pass is out of range");
     if (s.count < 1 || s.index < 0 || s.index >= s.count) bad("its shard number is out of range");
     CheckImageDimensions(s.width, s.height, what);
     // Its passes are the shard's, in order, each with the render's samples.
-    const std::vector<int64_t> expected = ShardPasses(s.passes, s.index, s.count);
+    const std::vector<int64_t> expected = ShardPasses(s.passes, s.index, s.count, s.first_pass);
     if (list.size() > expected.size()) bad("more passes than its shard holds");
     for (size_t i = 0; i < list.size(); ++i) {
         if (list[i].first != expected[i] ||
@@ -204,7 +209,7 @@ void MergeShards(const std::vector<ShardFile>& files, const std::vector<std::str
     for (size_t i = 0; i < files.size(); ++i) {
         const MonteCarloShard& s = files[i].shard;
         if (files[i].rows_done > 0 ||
-            s.pass_images.size() != ShardPasses(s.passes, s.index, s.count).size()) {
+            s.pass_images.size() != ShardPasses(s.passes, s.index, s.count, s.first_pass).size()) {
             Fail("shard ", name(i), " (", ShardName(s),
                  ") is unfinished (a checkpoint of a render in progress): finish it with "
                  "`atmos render ... --shard ",
@@ -227,8 +232,25 @@ void MergeShards(const std::vector<ShardFile>& files, const std::vector<std::str
                  " differ): merge only the shards of one render");
         }
     }
+    // The render: the largest spp among the shards; a shard of fewer paths
+    // (an earlier round) stands for its passes where they are whole passes
+    // of it.
+    const int64_t pass_spp = fingerprint.at("pass_spp").get<int64_t>();
+    int64_t spp = 0;
+    for (const ShardFile& f : files) spp = std::max(spp, f.shard.spp);
+    const int64_t passes = (spp + pass_spp - 1) / pass_spp;
+    for (size_t i = 0; i < files.size(); ++i) {
+        for (const MonteCarloPassImage& p : files[i].shard.pass_images) {
+            if (p.samples != PassSamples(p.index, spp, pass_spp)) {
+                Fail("pass ", p.index + 1, " in ", name(i), " holds ", p.samples,
+                     " paths per pixel (its render: --spp ", files[i].shard.spp, ") but ",
+                     PassSamples(p.index, spp, pass_spp), " in the render of --spp ", spp,
+                     " it is merged into: an earlier round merges into a later one only when its "
+                     "--spp is a multiple of --pass-spp");
+            }
+        }
+    }
     // Every pass exactly once.
-    const int64_t passes = first.passes;
     std::vector<const MonteCarloPassImage*> by_pass(static_cast<size_t>(passes), nullptr);
     std::vector<size_t> owner(static_cast<size_t>(passes), 0);
     for (size_t i = 0; i < files.size(); ++i) {
@@ -251,8 +273,11 @@ void MergeShards(const std::vector<ShardFile>& files, const std::vector<std::str
     }
     if (missing_count > 0) {
         // The shards of the first file's split that hold none of the given passes.
-        bool one_split = true;
-        for (const ShardFile& f : files) one_split &= f.shard.count == first.count;
+        bool one_split = first.first_pass == 0;
+        for (const ShardFile& f : files) {
+            one_split &=
+                f.shard.count == first.count && f.shard.first_pass == 0 && f.shard.spp == first.spp;
+        }
         std::string shards;
         for (int64_t k = 0; one_split && k < first.count && k < passes; ++k) {
             if (by_pass[static_cast<size_t>(k)] == nullptr) {

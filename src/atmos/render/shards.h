@@ -52,9 +52,14 @@ struct MonteCarloPassImage {
 struct MonteCarloShard {
     int64_t index = 0;
     int64_t count = 1;
+    // A later round (extending a render that stopped at first_pass passes):
+    // the shard holds the passes p >= first_pass with
+    // (p - first_pass) % count == index.
+    int64_t first_pass = 0;
     // Filled by the render:
-    std::string fingerprint;
-    int64_t passes = 0;  // passes of the whole render
+    std::string fingerprint;  // without spp: rounds of one render share it
+    int64_t spp = 0;          // paths per pixel of the render the shard belongs to
+    int64_t passes = 0;       // passes of that render
     int width = 0;
     int height = 0;
     std::vector<MonteCarloPassImage> pass_images;  // in pass order
@@ -109,13 +114,18 @@ ShardFile ParseShardFile(const std::string& bytes, const std::string& what);
 // Reads a shard file: a regular file, then ParseShardFile.
 ShardFile ReadShardFile(const std::string& path);
 
-// The passes of a render of `passes` passes that shard `index` of `count` holds.
-std::vector<int64_t> ShardPasses(int64_t passes, int64_t index, int64_t count);
+// The passes of a render of `passes` passes that shard `index` of `count` holds
+// (of the passes from first_pass on).
+std::vector<int64_t> ShardPasses(int64_t passes, int64_t index, int64_t count,
+                                 int64_t first_pass = 0);
 
-// Merges finished shards (names[i] names files[i] in messages): one
-// atmos::Error, before anything is computed, when a shard is unfinished, from
-// another render (its fingerprint differs: the fields that differ are named),
-// or when a pass is missing or held twice. Then the image (and, where given,
+// Merges finished shards (names[i] names files[i] in messages) into the render
+// of the largest spp among them (shards of a render of fewer paths, a first
+// round, stand for its passes when they are whole passes of the larger one):
+// one atmos::Error, before anything is computed, when a shard is unfinished,
+// from another render (its fingerprint differs: the fields that differ are
+// named; or its passes are not the larger render's), or when a pass is
+// missing or held twice. Then the image (and, where given,
 // the variance of its mean) exactly as the one-process render makes them;
 // report->samples gets the paths per pixel and report->noise the HDR-FLIP
 // between the means of the even and the odd passes (the measure of a noise
