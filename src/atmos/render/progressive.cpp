@@ -477,6 +477,12 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
         shard ? ShardPasses(passes, shard->index, shard->count, shard->first_pass)
               : ShardPasses(passes, 0, 1);
     const int64_t run_passes = static_cast<int64_t>(order.size());
+    // Its paths per pixel (a shard's own in the messages; noise targets
+    // are not split).
+    int64_t run_spp = shard ? 0 : spp;
+    for (size_t k = 0; shard && k < order.size(); ++k) {
+        run_spp += std::min(pass_spp, spp - order[k] * pass_spp);
+    }
     // A shard keeps each pass's mean (render/shards.h) instead of the sums.
     ShardFile shard_file;
     if (shard) {
@@ -645,8 +651,8 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
             }
             if (signal_number != 0) {
                 Fail("interrupted by ", StopSignalName(signal_number), " in pass ", k + 1, " of ",
-                     run_passes, " (", samples_done, " of ", spp, " samples per pixel and ", row,
-                     " of ", height, " rows of the next pass done); the checkpoint '", path,
+                     run_passes, " (", samples_done, " of ", run_spp, " samples per pixel and ",
+                     row, " of ", height, " rows of the next pass done); the checkpoint '", path,
                      "' holds them: the same command with --resume continues");
             }
         }
@@ -682,7 +688,7 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
         }
         if (signal_number != 0 && k + 1 < run_passes && !reached) {
             Fail("interrupted by ", StopSignalName(signal_number), " after pass ", passes_done,
-                 " of ", run_passes, " (", samples_done, " of ", spp,
+                 " of ", run_passes, " (", samples_done, " of ", run_spp,
                  " samples per pixel); the checkpoint '", path,
                  "' holds them: the same command with --resume continues");
         }
