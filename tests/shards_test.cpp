@@ -6,6 +6,7 @@
 // (`render --shard K/N`, `atmos merge`) with the path tracer.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cstdlib>
@@ -386,6 +387,16 @@ TEST(Shards, CliThreeShardsMergeToTheOneProcessImage) {
     }
     const std::string p1 = (dir / "part1.shard").string(), p2 = (dir / "part2.shard").string(),
                       p3 = (dir / "part3.shard").string();
+    // The fingerprint names what fixes the passes (the estimator's version too).
+    const nlohmann::json fp =
+        nlohmann::json::parse(ParseShardFile(FileBytes(p1), p1).shard.fingerprint);
+    EXPECT_EQ(fp.at("model"), "reference");
+    EXPECT_EQ(fp.at("view"), "ground-sunrise");
+    EXPECT_EQ(fp.at("seed"), 7);
+    EXPECT_EQ(fp.at("width"), 16);
+    EXPECT_EQ(fp.at("pass_spp"), 2);
+    EXPECT_TRUE(fp.at("model_key").contains("estimator_version")) << fp.dump();
+    EXPECT_TRUE(fp.at("model_key").contains("atmosphere")) << fp.dump();
     Result r = RunCli(
         "merge -q " + p3 + " " + p1 + " " + p2 + " -o " + (dir / "merged.exr").string(), dir);
     ASSERT_EQ(r.status, 0) << r.err;

@@ -283,6 +283,9 @@ const ReferenceEvaluator& ReferenceModel::evaluator() const {
 
 std::string ReferenceModel::PassKey() const {
     nlohmann::json key;
+    // Bumped with any change that could move the expected value: a checkpoint
+    // or a shard of an older estimator is another render (issue 36).
+    key["estimator_version"] = kReferenceEstimatorVersion;
     key["max_order"] = evaluator_.max_order;
     key["estimator"] = evaluator_.estimator == ReferenceEstimator::kHybrid     ? "hybrid"
                        : evaluator_.estimator == ReferenceEstimator::kTracking ? "spectral"
