@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <random>
 #include <string>
@@ -302,6 +304,36 @@ TEST(HosekWilkie, OutsideValidity) {
     const double outside[3] = {319.0, 550.0, 600.0};
     EXPECT_THROW(m->SetSpectralBatch(SpectralAtmosphere(), outside), Error);
     EXPECT_THROW(HosekWilkieSolarIrradiance(720.5), Error);
+}
+
+// The bake (issue 34 item 6: the model as a shader): the constants it writes
+// reload into the same answers, and a bake for other options or another
+// atmosphere is refused.
+TEST(HosekWilkie, BakeReloadsTheSameAnswersAndRefusesOtherOptions) {
+    const char* env = std::getenv("ATMOS_TEST_TMP");
+    const std::filesystem::path dir =
+        std::filesystem::path(env ? env : "/tmp") / "hosek_wilkie_bake";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::unique_ptr<Model> baked = Make("hosek-wilkie:turbidity=4.5:albedo=0.3");
+    ASSERT_TRUE(baked->CanBake());
+    baked->Bake(dir.string());
+    ASSERT_TRUE(std::filesystem::exists(dir / "shaders" / "hosek_wilkie_constants.glsl"));
+    const std::vector<SampleQuery> queries = {Query(30.0, 50.0, 40.0), Query(5.0, 80.0, 10.0)};
+    std::unique_ptr<Model> loaded = Make("hosek-wilkie:turbidity=4.5:albedo=0.3");
+    loaded->LoadBaked(dir.string(), EarthAtmosphere());
+    const std::vector<SampleAnswer> a = baked->Sample(queries), b = loaded->Sample(queries);
+    for (size_t q = 0; q < queries.size(); ++q) {
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(At(a[q].radiance, c), At(b[q].radiance, c));
+    }
+    EXPECT_THROW(
+        Make("hosek-wilkie:turbidity=5:albedo=0.3")->LoadBaked(dir.string(), EarthAtmosphere()),
+        Error);
+    AtmosphereParameters other = EarthAtmosphere();
+    other.bottom_radius *= 1.01;
+    other.top_radius *= 1.01;
+    EXPECT_THROW(loaded->LoadBaked(dir.string(), other), Error);
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // The engine path equals the library (issue 20): `atmos viewer` bakes
-// bruneton, hillaire and atmosphere-plus and writes the WebGL2 page; headless Chromium (Debian's
-// `chromium`, WebGL2 on SwiftShader) renders the 12 views of each from the baked
+// bruneton, hillaire, atmosphere-plus and hosek-wilkie and writes the WebGL2 page; headless
+// Chromium (Debian's `chromium`, WebGL2 on SwiftShader) renders the 12 views of each from the baked
 // float32 tables with shaders/NAME.glsl into a float framebuffer, the page
 // puts the pixels in the DOM (read back with --dump-dom), and each must match
 // `atmos render --load` of the same view from the same tables: mean HDR-FLIP
@@ -116,16 +116,19 @@ void ExpectBrowserMatchesAtmosRender(const std::string& sets) {
     const std::string aplus =
         "atmosphere-plus:orders=2:table-width=16:table-height=32:table-depth=16:"
         "transmittance-width=16:transmittance-height=64:gather-theta=6:gather-phi=12";
-    const std::map<std::string, std::string> models = {
-        {"bruneton", bruneton}, {"hillaire", "hillaire"}, {"atmosphere-plus", aplus}};
-    ASSERT_EQ(
-        System(cli + " viewer" + sets + " --models " + bruneton + ",hillaire," + aplus + " -o " +
-               page.string() + " --quiet > " + (dir / "viewer.log").string() + " 2>&1"),
-        0)
+    const std::map<std::string, std::string> models = {{"bruneton", bruneton},
+                                                       {"hillaire", "hillaire"},
+                                                       {"atmosphere-plus", aplus},
+                                                       {"hosek-wilkie", "hosek-wilkie"}};
+    ASSERT_EQ(System(cli + " viewer" + sets + " --models " + bruneton + ",hillaire," + aplus +
+                     ",hosek-wilkie -o " + page.string() + " --quiet > " +
+                     (dir / "viewer.log").string() + " 2>&1"),
+              0)
         << Slurp(dir / "viewer.log");
     for (const char* shader :
          {"bruneton/shaders/bruneton.glsl", "hillaire/shaders/hillaire.glsl",
-          "atmosphere-plus/shaders/atmosphere_plus.glsl", "atmosphere-plus/shaders/common.glsl"}) {
+          "atmosphere-plus/shaders/atmosphere_plus.glsl", "atmosphere-plus/shaders/common.glsl",
+          "hosek-wilkie/shaders/hosek_wilkie.glsl"}) {
         ASSERT_TRUE(fs::exists(page / shader)) << shader;
     }
 
@@ -173,7 +176,7 @@ void ExpectBrowserMatchesAtmosRender(const std::string& sets) {
         std::memcpy(b.image.data(), bytes.data(), bytes.size());
         images.push_back(std::move(b));
     }
-    ASSERT_EQ(images.size(), 36u);
+    ASSERT_EQ(images.size(), 48u);  // 4 models x 12 views
 
     // The library from the same tables.
     const fs::path renders = dir / "render";

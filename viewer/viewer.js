@@ -165,7 +165,8 @@ function compile(gl, type, source) {
 function makeModel(gl, name, format) {
   var data = atmosViewerData.models[name];
   var blobText = atmosViewerData.tables[name + '/' + format];
-  if (!data || !blobText) throw new Error('no baked data for model ' + name);
+  // A model without tables (hosek-wilkie: constants only) has an empty blob.
+  if (!data || blobText === undefined) throw new Error('no baked data for model ' + name);
   var fragment = '#version 300 es\nprecision highp float;\nprecision highp sampler2D;\n' +
                  'precision highp sampler3D;\n' + data.constants + '\n' + data.functions +
                  '\n' + MAIN_SHADER;
@@ -187,7 +188,8 @@ function makeModel(gl, name, format) {
     hillaire: [['atmos_transmittance_texture', 'transmittance'],
                ['atmos_multiple_scattering_texture', 'multiple_scattering']],
     'atmosphere-plus': [['atmos_scattering_texture', 'scattering'],
-                        ['atmos_transmittance_texture', 'transmittance']]}[name];
+                        ['atmos_transmittance_texture', 'transmittance']],
+    'hosek-wilkie': []}[name];
   var textures = [];
   gl.useProgram(program);
   samplers.forEach(function (s) {

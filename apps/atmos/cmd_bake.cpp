@@ -1,6 +1,6 @@
 // atmos CLI: `atmos bake`: a model's precomputed tables as files for other
 // engines (EXR, raw float32/float16, JSON) with the GLSL that reads them; and
-// `atmos viewer`: those, for the models with shaders (bruneton, hillaire,
+// `atmos viewer`: those, for the models with shaders (bruneton, hillaire, hosek-wilkie,
 // atmosphere-plus), in a WebGL2 page.
 #include <cstdio>
 #include <filesystem>
@@ -110,11 +110,12 @@ Command AddViewerCommand(CLI::App* root) {
         "DIR/index.html; no network)",
         common.get(), output.get());
     c.app
-        ->add_option("--models", *models,
-                     "models to bake, NAME[:OPTION=VALUE...] comma-separated (default: "
-                     "every model with a viewer shader: hillaire,bruneton,atmosphere-plus); "
-                     "with --load DIR, one model read from DIR (default: the model of DIR's "
-                     "bake)")
+        ->add_option(
+            "--models", *models,
+            "models to bake, NAME[:OPTION=VALUE...] comma-separated (default: "
+            "every model with a viewer shader: hillaire,bruneton,atmosphere-plus,hosek-wilkie); "
+            "with --load DIR, one model read from DIR (default: the model of DIR's "
+            "bake)")
         ->delimiter(',');
     CLI::Option* model_flag = c.app->get_option("--model");
     c.run = [common, output, models, model_flag] {

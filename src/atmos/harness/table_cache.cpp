@@ -208,7 +208,10 @@ TablePrepareResult PrepareWithTableCache(Model* model,
         result.prepare_seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
-    if (settings.directory.empty() || !model->CanBake()) {
+    // Only tables worth caching: a model that bakes constants alone
+    // (hosek-wilkie's shader) prepares in microseconds.
+    if (settings.directory.empty() || !model->CanBake() ||
+        !model->Info().capabilities.precomputed) {
         prepare();
         return result;
     }

@@ -3,12 +3,18 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "atmos/error.h"
 #include "atmos/spectral.h"
+#include "io/output_path.h"
+#include "io/raw_tables.h"
+#include "models/option_json.h"
 
 namespace atmos {
 
@@ -169,6 +175,7 @@ ModelInfo HosekWilkieModel::StaticInfo() {
     info.capabilities.space_views = false;
     info.capabilities.sun_below_horizon = false;
     info.capabilities.multiple_scattering = true;  // fitted to a full simulation
+    info.capabilities.shader = "hosek_wilkie";
     info.options = OptionRows().Specs();
     return info;
 }
@@ -178,14 +185,17 @@ const OptionTable<HosekWilkieOptions>& HosekWilkieModel::OptionRows() {
         OptionTable<HosekWilkieOptions>()
             .Real("turbidity", &HosekWilkieOptions::turbidity, 1.0, 10.0, "",
                   "atmospheric turbidity T")
+            .ShapesTables()
             .Text("albedo", &HosekWilkieOptions::albedo,
                   "ground albedo in [0, 1] (default: the atmosphere's, the mean of its channels)")
+            .ShapesTables()
             .Choice("colour", &HosekWilkieOptions::colour,
                     {{"rgb", HosekWilkieColour::kRgb},
                      {"xyz", HosekWilkieColour::kXyz},
                      {"spectral", HosekWilkieColour::kSpectral}},
                     "coefficient set: the authors' RGB fit, their CIE XYZ fit (to linear sRGB), "
                     "or their spectral fit at 680/550/440 nm")
+            .ShapesTables()
             .Validate([](const std::string&, const HosekWilkieOptions& o,
                          const std::set<std::string>&) { ParseAlbedo(o.albedo); });
     return table;
@@ -252,6 +262,86 @@ void HosekWilkieModel::SetSpectralBatch(const SpectralAtmosphere&, const double 
         nm_[c] = nm[c];
     }
     spectral_batch_ = true;
+}
+
+namespace {
+
+constexpr const char* kBakeJson = "hosek-wilkie.json";
+constexpr int kBakeFormatVersion = 1;
+
+// The #defines and arrays shaders/hosek_wilkie.glsl reads: ATMOS_HW_SOURCES,
+// ATMOS_HW_CONTROL (source s, control point i, parameter p at
+// 60 s + 10 i + p: A B C D E F G I H L_M) and ATMOS_HW_MIX (channel c, source s
+// at kHosekWilkieMaxSources c + s), from the evaluator Prepare() built.
+std::string GlslConstants(const AtmosphereParameters& a, const HosekWilkieEvaluator& e) {
+    std::ostringstream o;
+    o << "// atmos bake: the constants of the hosek-wilkie model (Hosek & Wilkie 2012, "
+         "eq. 8-9),\n// blended in turbidity and albedo; read by shaders/common.glsl and "
+         "shaders/hosek_wilkie.glsl.\n";
+    WriteGlslAtmosphere(o, a);
+    o.precision(9);
+    o << std::scientific;
+    o << "#define ATMOS_HW_SOURCES " << e.sources << "\n";
+    o << "const float ATMOS_HW_CONTROL[" << e.sources * 60 << "] = float[](";
+    for (int s = 0; s < e.sources; ++s) {
+        for (int i = 0; i < 6; ++i) {
+            o << "\n   ";
+            for (int p = 0; p < 10; ++p) {
+                o << " " << e.ctrl[s][i][p] << (s + 1 < e.sources || i < 5 || p < 9 ? "," : "");
+            }
+        }
+    }
+    o << ");\n";
+    o << "const float ATMOS_HW_MIX[" << 3 * kHosekWilkieMaxSources << "] = float[](";
+    for (int c = 0; c < 3; ++c) {
+        o << "\n   ";
+        for (int s = 0; s < kHosekWilkieMaxSources; ++s) {
+            o << " " << e.mix[c][s] << (c < 2 || s + 1 < kHosekWilkieMaxSources ? "," : "");
+        }
+    }
+    o << ");\n";
+    return o.str();
+}
+
+}  // namespace
+
+void HosekWilkieModel::Bake(const std::string& directory) const {
+    namespace fs = std::filesystem;
+    nlohmann::ordered_json j;
+    j["model"] = "hosek-wilkie";
+    j["format_version"] = kBakeFormatVersion;
+    j["options"] = OptionsJson(OptionRows().Specs(), OptionRows().Values(options_));
+    j["atmosphere"] = nlohmann::ordered_json::parse(AtmosphereToJson(atmosphere()));
+    j["raw"] = WriteRawTables(directory, {});  // no tables: empty blobs
+    j["shaders"] =
+        WriteGlslConstants(directory, "hosek_wilkie", GlslConstants(atmosphere(), evaluator_));
+    WriteFileAtomically((fs::path(directory) / kBakeJson).string(), j.dump(2) + "\n");
+}
+
+void HosekWilkieModel::LoadBaked(const std::string& directory,
+                                 const AtmosphereParameters& atmosphere) {
+    const std::string path = (std::filesystem::path(directory) / kBakeJson).string();
+    std::ifstream in(path);
+    if (!in) Fail("hosek-wilkie: cannot read ", path, " (not a hosek-wilkie bake directory?)");
+    nlohmann::json j;
+    try {
+        in >> j;
+    } catch (const std::exception& e) {
+        Fail("hosek-wilkie: ", path, " is not valid JSON: ", e.what());
+    }
+    if (!j.is_object() || j.value("model", "") != "hosek-wilkie") {
+        Fail("hosek-wilkie: ", path, " was not baked by model hosek-wilkie");
+    }
+    if (j.value("format_version", -1) != kBakeFormatVersion || !j.contains("options")) {
+        Fail("hosek-wilkie: ", path, " was baked by another version of atmos: bake it again");
+    }
+    if (!j.contains("atmosphere") ||
+        j["atmosphere"] != nlohmann::json::parse(AtmosphereToJson(atmosphere))) {
+        Fail("hosek-wilkie: ", path, " was baked for another atmosphere");
+    }
+    CheckBakedOptions(path, nlohmann::ordered_json::parse(j["options"].dump()),
+                      OptionRows().Specs(), OptionRows().Values(options_));
+    Prepare(atmosphere);
 }
 
 }  // namespace atmos

@@ -222,6 +222,14 @@ class HosekWilkieModel : public SimpleEvaluatorModel<HosekWilkieModel, HosekWilk
     // The batch's wavelengths (atmos::Error outside 320-720 nm); the next
     // Prepare() builds the spectral form at them.
     void SetSpectralBatch(const SpectralAtmosphere& atmosphere, const double nm[3]) override;
+    // No tables: a bake writes the blended control points and the channel mix
+    // as shader constants (shaders/hosek_wilkie.glsl) and hosek-wilkie.json;
+    // LoadBaked checks that JSON against the options and atmosphere and
+    // prepares again (microseconds).
+    bool CanBake() const override { return true; }
+    void Bake(const std::string& directory) const override;
+    int64_t TableBytes() const override { return 0; }
+    void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere) override;
 
   private:
     HosekWilkieOptions options_;
