@@ -58,6 +58,7 @@ int CmdCompare(CompareCliOptions o) {
     ThreadLimit limit(o.study.threads);
     const BackendScope backend(ParseBackend(o.study.backend));
     const CompareResult r = RunCompare(config);
+    WriteCompareImages(config, r);
     WriteCompareTables(config, r);
     if (!o.study.quiet) {
         std::fprintf(stderr, "compared %zu models at %zu views in %.1f s (%d threads)\n",

@@ -223,6 +223,7 @@ void BindStudies(py::module_& mod) {
             {
                 py::gil_scoped_release release;
                 r = RunCompare(config);
+                WriteCompareImages(config, r);
                 WriteCompareTables(config, r);
             }
             return CompareDict(config, r);

@@ -330,8 +330,6 @@ CompareResult RunCompare(const CompareConfig& config) {
     std::vector<View> views;
     for (const std::string& v : view_names) views.push_back(GetView(v, config.atmosphere));
 
-    const fs::path out(config.output_dir);
-    fs::create_directories(out);
     const RenderCache cache(config.cache_dir);
     // A Monte Carlo reference: two independent halves, averaged (the same
     // number of paths), whose difference measures its noise.
@@ -401,11 +399,7 @@ CompareResult RunCompare(const CompareConfig& config) {
         row.view = view.name;
         row.label = CompareRowLabel(view.name, config.quantity);
         row.description = view.description;
-        const float exposure = transmittance ? 1.0f : view.exposure;
-        const fs::path image_dir = out / "images" / FileStem(view.name);
-        const fs::path error_dir = out / "errors" / FileStem(view.name);
-        fs::create_directories(image_dir);
-        fs::create_directories(error_dir);
+        row.exposure = transmittance ? 1.0f : view.exposure;
         MonteCarloReport ref_report;
         Image ref_variance;  // per-pixel variance of the reference's estimate (may stay empty)
         Image ref;
@@ -485,13 +479,12 @@ CompareResult RunCompare(const CompareConfig& config) {
                 row.profiles.push_back(std::move(profile));
             }
         }
-        Image rgb_ref;
         if (spectral_reference) {
             bool cached_rgb = false;
-            rgb_ref = rgb_reference.Render(view, &row.rgb_reference_seconds, &cached_rgb);
-            WriteImages(rgb_ref, image_dir, "reference-rgb", exposure, config.write_npy);
+            row.rgb_reference_image =
+                rgb_reference.Render(view, &row.rgb_reference_seconds, &cached_rgb);
         }
-        WriteImages(ref, image_dir, "reference", exposure, config.write_npy);
+        const Image& rgb_ref = row.rgb_reference_image;
         row.reference_png = (fs::path("images") / FileStem(view.name) / "reference.png").string();
         if (config.show_progress) {
             std::fprintf(stderr, "%-22s reference (%s) %s %.3f s", view.name.c_str(),
@@ -515,9 +508,9 @@ CompareResult RunCompare(const CompareConfig& config) {
             const std::string& name = result.models[m];
             const std::string stem = FileStem(name);
             CompareCell cell;
-            const Image img = renderers[m]->Render(view, &cell.render_seconds, &cell.cached);
-            WriteImages(img, image_dir, stem, exposure, config.write_npy);
-            const FlipResult flip =
+            cell.image = renderers[m]->Render(view, &cell.render_seconds, &cell.cached);
+            const Image& img = cell.image;
+            FlipResult flip =
                 transmittance ? LdrFlip(ref, img, config.flip) : HdrFlip(ref, img, config.flip);
             const RmseResult rmse = ComputeRmse(ref, img);
             cell.flip = flip.mean;
@@ -528,11 +521,7 @@ CompareResult RunCompare(const CompareConfig& config) {
                 profile.models.push_back(ProfileLuminance(img, profile.line));
             }
             cell.within_noise = row.reference_noise >= 0.0 && cell.flip <= row.reference_noise;
-            WriteColorMappedPng(flip.map, flip.width, flip.height,
-                                (error_dir / (stem + "-flip.png")).string());
-            const Image abs_error = AbsoluteErrorImage(ref, img);
-            WriteImage(abs_error, (error_dir / (stem + "-rmse.exr")).string());
-            WriteImage(abs_error, (error_dir / (stem + "-rmse.png")).string(), exposure);
+            cell.flip_map = std::move(flip.map);
             cell.validity_note = ValidityNote(GetModelInfo(result.model_names[m]).capabilities,
                                               view, config.atmosphere);
             cell.image_png = (fs::path("images") / FileStem(view.name) / (stem + ".png")).string();
@@ -550,9 +539,10 @@ CompareResult RunCompare(const CompareConfig& config) {
                 }
                 std::fprintf(stderr, "\n");
             }
-            row.cells.push_back(cell);
+            row.cells.push_back(std::move(cell));
         }
-        result.rows.push_back(row);
+        row.reference_image = std::move(ref);
+        result.rows.push_back(std::move(row));
     }
     for (const auto& r : renderers) {
         r->LoadPrepareRecord();
@@ -576,6 +566,31 @@ CompareResult RunCompare(const CompareConfig& config) {
     result.reference_noise_target = noise_target ? mc.noise_target : 0.0;
     result.total_seconds = SecondsSince(start);
     return result;
+}
+
+void WriteCompareImages(const CompareConfig& config, const CompareResult& r) {
+    const fs::path out(config.output_dir);
+    for (const CompareRow& row : r.rows) {
+        const fs::path image_dir = out / "images" / FileStem(row.view);
+        const fs::path error_dir = out / "errors" / FileStem(row.view);
+        fs::create_directories(image_dir);
+        fs::create_directories(error_dir);
+        if (row.rgb_reference_image.size() > 0) {
+            WriteImages(row.rgb_reference_image, image_dir, "reference-rgb", row.exposure,
+                        config.write_npy);
+        }
+        WriteImages(row.reference_image, image_dir, "reference", row.exposure, config.write_npy);
+        for (size_t m = 0; m < row.cells.size() && m < r.models.size(); ++m) {
+            const CompareCell& cell = row.cells[m];
+            const std::string stem = FileStem(r.models[m]);
+            WriteImages(cell.image, image_dir, stem, row.exposure, config.write_npy);
+            WriteColorMappedPng(cell.flip_map, cell.image.width(), cell.image.height(),
+                                (error_dir / (stem + "-flip.png")).string());
+            const Image abs_error = AbsoluteErrorImage(row.reference_image, cell.image);
+            WriteImage(abs_error, (error_dir / (stem + "-rmse.exr")).string());
+            WriteImage(abs_error, (error_dir / (stem + "-rmse.png")).string(), row.exposure);
+        }
+    }
 }
 
 void WriteCompareTables(const CompareConfig& config, const CompareResult& r) {

@@ -3,12 +3,14 @@
 // sections 11.5-11.7 and Appendix A-D).
 //
 // For each view and model: render (or load from the render cache) the
-// reference and the model, write the images (PNG, EXR, NPY), the FLIP error
-// map (colour-mapped PNG) and the RMSE map (per-channel |difference|, EXR and
-// PNG), and collect FLIP and RMSE into tables laid out like the thesis's
+// reference and the model, keep the images and the FLIP error map in the
+// result, and collect FLIP and RMSE into tables laid out like the thesis's
 // appendices: rows = views, columns = models, the best (lowest) of each row
 // named in a last column "best". Radiance uses HDR-FLIP on the linear images;
-// transmittance uses LDR-FLIP (values in [0, 1]), as the thesis did.
+// transmittance uses LDR-FLIP (values in [0, 1]), as the thesis did. The run
+// does no file output (the render cache aside); the writers below write the
+// images (PNG, EXR, NPY), the FLIP map (colour-mapped PNG), the error image
+// (per-channel |difference|, EXR and PNG), the tables and the report from it.
 #pragma once
 
 #include <map>
@@ -85,6 +87,10 @@ struct CompareCell {
     std::string image_png;  // paths relative to the output directory
     std::string flip_png;
     std::string rmse_png;
+    // The model's image and its per-pixel FLIP map against the reference
+    // (width x height, row-major; WriteCompareImages writes them).
+    Image image;
+    std::vector<float> flip_map;
 };
 
 struct CompareRow {
@@ -92,6 +98,11 @@ struct CompareRow {
     std::string label;  // the table's row label (transmittance: ground, plane, ...)
     std::string description;
     std::string reference_png;
+    float exposure = 1.0f;  // the view's PNG exposure (transmittance: 1)
+    // The reference's image and, with --reference-wavelengths, the RGB
+    // reference's (else empty); WriteCompareImages writes them.
+    Image reference_image;
+    Image rgb_reference_image;
     double reference_seconds = 0.0;
     bool reference_cached = false;
     // Where the reference came from: "rendered", "cached" or "shipped"
@@ -159,11 +170,18 @@ std::string ValidityNote(const ModelCapabilities& caps, const View& view,
 // (e.g. `hillaire:segment-offset=0.5`), so that variants of one model are
 // compared side by side; the spec text names the model's column and files.
 
-// Runs the comparison (studies/compare.h resolves the config) and writes each
-// view's images and error maps into config.output_dir as it goes (they are too
-// large to keep); the tables and the report are WriteCompareTables'. Throws
-// atmos::Error.
+// Runs the comparison (studies/compare.h resolves the config) and returns its
+// plain data, images included: it writes no file but the render cache's
+// (config.cache_dir), and prints progress lines to stderr with
+// config.show_progress. The images cost 4 bytes per channel and pixel: at the
+// default 320x180, 12 views and 11 models about 12 x (12 x 0.69 + 11 x 0.23)
+// MB = 130 MB; at 1920x1080 about 4.7 GB. Throws atmos::Error.
 CompareResult RunCompare(const CompareConfig& config);
+// Writes each view's images into config.output_dir: images/VIEW/reference,
+// reference-rgb (--reference-wavelengths) and each model (.png at the view's
+// exposure, .exr, .npy unless !write_npy), errors/VIEW/MODEL-flip.png (the FLIP
+// map, magma), MODEL-rmse.exr and .png (|model - reference|). Only reads `result`.
+void WriteCompareImages(const CompareConfig& config, const CompareResult& result);
 // The writers of a result: flip.csv, rmse.csv, times.csv, reference_noise.csv
 // (when measured), rgb_cost.csv (reference_wavelengths), accuracy_cost.csv and
 // index.html in config.output_dir. They only read `result`.

@@ -640,8 +640,7 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
     for (const CompareRow& row : r.rows) {
         f << "<h3 id=\"view-" << HtmlEscape(row.view) << "\">" << HtmlEscape(row.label)
           << "</h3><p>" << HtmlEscape(row.description) << "</p>\n";
-        const float exposure = transmittance ? 1.0f : GetView(row.view, config.atmosphere).exposure;
-        ColourBars(f, config, exposure);
+        ColourBars(f, config, row.exposure);
         f << "<div class=\"row\">\n<figure><img src=\"" << HtmlEscape(row.reference_png)
           << "\" alt=\"reference\" title=\"reference, " << HtmlEscape(row.label)
           << "\"><figcaption><b>reference</b> (" << HtmlEscape(config.reference_model) << ")<br>"
