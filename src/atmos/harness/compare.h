@@ -32,6 +32,9 @@ struct CompareConfig {
     std::vector<std::string>
         models;  // empty: every registered model with the quantity, but Monte Carlo ones
     std::vector<std::string> views;  // empty: DefaultCompareViews(quantity)
+    // Custom views (--views FILE.json, studies/compare_views.h) for
+    // `atmosphere`: `views` names them among the 12 named ones.
+    std::vector<View> custom_views;
     int width = 320;
     int height = 180;
     Quantity quantity = Quantity::kRadiance;
@@ -71,6 +74,22 @@ struct CompareConfig {
     bool write_npy = true;
     bool show_progress = true;
     std::string command_line;  // for the report
+    // --luminance: each image's mean photopic luminance (luminance.csv, the
+    // report) and the profiles in cd m^-2: Rec. 709 Y of the image times
+    // luminance_scale / the view's sun_irradiance (studies/compare.h says what
+    // the scale is for RGB and spectral runs; luminance_note says it in the report).
+    bool luminance = false;
+    double luminance_scale = 0.0;
+    std::string luminance_note;
+    // How the models rendered, for the cost columns: "CPU" or "CUDA GPU".
+    std::string machine = "CPU";
+};
+
+// Mean luminance over the image and its regions (--luminance: cd m^-2).
+struct CompareLuminance {
+    double all = -1.0;
+    double sky = -1.0;
+    double ground = -1.0;
 };
 
 struct CompareCell {
@@ -80,7 +99,12 @@ struct CompareCell {
     // --reference-wavelengths: HDR-FLIP against the RGB reference (else < 0).
     double flip_rgb_reference = -1.0;
     bool cached = false;
-    std::string validity_note;  // non-empty: the view is outside the model's declared validity
+    // Sky and ground apart (harness/compare_regions.h): FLIP and RMSE over
+    // the sky and over the ground pixels (NaN when the view has none).
+    double flip_sky = 0.0, flip_ground = 0.0;
+    double rmse_sky = 0.0, rmse_ground = 0.0;
+    CompareLuminance luminance;  // --luminance
+    std::string validity_note;   // non-empty: the view is outside the model's declared validity
     // FLIP at or below the row's reference_noise: the difference to the
     // reference is not resolved by it.
     bool within_noise = false;
@@ -122,6 +146,18 @@ struct CompareRow {
     // variance of its estimate): its noise in RMSE units, the tie tolerance of
     // the RMSE table. Negative when not known.
     double reference_rmse_noise = -1.0;
+    // Sky and ground: pixel counts; the reference's noise per region: FLIP
+    // between its halves (measured only for a fixed-spp split reference; else
+    // < 0) and twice its RMS standard error (< 0 when not known); its mean
+    // luminance (Rec. 709 Y, image units) per region.
+    int64_t sky_pixels = 0, ground_pixels = 0;
+    double reference_noise_sky = -1.0, reference_noise_ground = -1.0;
+    double reference_rmse_noise_sky = -1.0, reference_rmse_noise_ground = -1.0;
+    double reference_mean_sky = 0.0, reference_mean_ground = 0.0;
+    CompareLuminance reference_luminance;  // --luminance
+    double luminance_scale = 0.0;          // --luminance: cd m^-2 per unit Y of this view's images
+    // The view's regimes (harness/regimes.h): where the camera is, how the sun lights it.
+    std::string place, light;
     std::vector<CompareCell> cells;  // one per model, in CompareResult::models order
     // Luminance along the column through the sun and the row above the
     // horizon (profiles.h): the reference, its standard deviation (empty when

@@ -27,7 +27,11 @@ constexpr int64_t kCompareReferenceCap = 512;
 struct CompareRequest {
     std::vector<std::string>
         models;  // specs; empty: every model with the quantity but the reference
-    std::vector<std::string> views;  // empty: DefaultCompareViews(quantity)
+    // Views: names of the 12, or views files (NAME.json, studies/compare_views.h)
+    // whose entries join in the file's order; empty: DefaultCompareViews(quantity).
+    std::vector<std::string> views;
+    // Custom views as JSON text (Python's views=dict), after `views`' entries.
+    std::string views_json;
     int width = 320, height = 180;
     std::string quantity = "radiance";  // radiance (HDR-FLIP) or transmittance (LDR-FLIP)
     // The reference NAME[:OPTION=VALUE...]; unset: CompareConfig's (the path tracer).
@@ -61,10 +65,27 @@ struct CompareRequest {
     // exists and the reference renders to a noise target; no_shipped: never.
     std::optional<std::string> shipped_references;
     bool no_shipped = false;
+    // Photopic luminance in cd m^-2 (luminance.csv, the report's profiles):
+    // Rec. 709 Y of the images (for a spectral run the CIE 1931 Y, the images
+    // being linear sRGB from XYZ) times a scale, per unit of the view's
+    // sun_irradiance: with --wavelengths 683 lm/W x 106.86 nm (the solar
+    // spectrum in W m^-2 nm^-1 makes the images W m^-2 sr^-1 nm^-1); RGB
+    // runs, whose images are radiance per unit solar irradiance, times the
+    // Sun's illuminance at the top of the atmosphere at 1 AU computed from the
+    // ASTM G173 extraterrestrial spectrum (683 x integral of E y dlambda, about
+    // 1.3e5 lx): Y then stands for the sky's luminance under the real Sun,
+    // with the RGB channels taken as the spectrum's luminance-weighted
+    // samples. Radiance only; not with reference_wavelengths.
+    bool luminance = false;
     std::string command_line;  // for the report
 };
 
 // The defaults and the policy; throws atmos::Error naming the flag.
 CompareConfig ResolveCompareConfig(const CompareRequest& request);
+
+// The Sun's illuminance (lx) at the top of the atmosphere at 1 AU: 683 lm/W
+// times the integral of the ASTM G173 extraterrestrial spectrum (W m^-2 nm^-1)
+// against the CIE 1931 y function.
+double SolarIlluminanceLux();
 
 }  // namespace atmos
