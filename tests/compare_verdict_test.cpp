@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "atmos/error.h"
+#include "atmos/spectral.h"
 #include "harness/compare_regions.h"
 #include "harness/regimes.h"
 #include "harness/report.h"
@@ -336,6 +337,15 @@ TEST(CompareVerdict, RunWritesRegionsRegimesAndLuminance) {
                 1e-6 * SolarIlluminanceLux());
     EXPECT_NEAR(r.rows[0].cells[1].luminance.sky, SolarIlluminanceLux(),
                 1e-6 * SolarIlluminanceLux());
+    // A tabulated solar spectrum (W m^-2 nm^-1) makes the images physical:
+    // 683 lm/W x the CIE y integral; a flat one (earth's), per unit irradiance.
+    CompareRequest spectral = q;
+    spectral.atmosphere = "earth-spectral";
+    EXPECT_NEAR(ResolveCompareConfig(spectral).luminance_scale,
+                kMaxLuminousEfficacy * CieYIntegral(), 1e-9);
+    spectral.wavelengths = {450.0, 550.0, 650.0};
+    spectral.atmosphere = "earth";
+    EXPECT_EQ(ResolveCompareConfig(spectral).luminance_scale, SolarIlluminanceLux());
     WriteCompareImages(config, r);
     WriteCompareTables(config, r);
     const fs::path out = config.output_dir;

@@ -101,12 +101,14 @@ CompareConfig ResolveCompareConfig(const CompareRequest& q) {
                 "models' images are in different units there)");
         }
         config.luminance = true;
-        if (!q.wavelengths.empty()) {
+        if (HasPhysicalSolarSpectrum(LoadSpectralAtmosphere(q.atmosphere, q.sets))) {
             config.luminance_scale = kMaxLuminousEfficacy * CieYIntegral();
             config.luminance_note =
-                "cd m^-2: the CIE 1931 Y of the spectral images (W m^-2 sr^-1 nm^-1 with the "
-                "atmosphere's solar spectrum in W m^-2 nm^-1) x 683 lm/W x 106.86 nm, per unit "
-                "of the view's sun multiplier";
+                std::string("cd m^-2: Y of the images (") +
+                (q.wavelengths.empty() ? "Rec. 709 Y of RGB radiance at 680, 550, 440 nm"
+                                       : "CIE 1931 Y of the spectral images") +
+                ", W m^-2 sr^-1 nm^-1 with the atmosphere's tabulated solar spectrum in W m^-2 "
+                "nm^-1) x 683 lm/W x 106.86 nm, per unit of the view's sun multiplier";
         } else {
             config.luminance_scale = SolarIlluminanceLux();
             char buf[64];
@@ -191,6 +193,14 @@ CompareConfig ResolveCompareConfig(const CompareRequest& q) {
                                  "rgb_cost.csv compares each model with the RGB reference too";
     }
     return config;
+}
+
+bool HasPhysicalSolarSpectrum(const SpectralAtmosphere& atmosphere) {
+    if (!atmosphere.spectral) return false;  // an RGB file: per unit solar irradiance
+    for (const SpectralTerm& t : atmosphere.solar_irradiance.terms) {
+        if (t.kind == SpectralTerm::Kind::kTable) return true;
+    }
+    return false;
 }
 
 double SolarIlluminanceLux() {

@@ -68,14 +68,14 @@ struct CompareRequest {
     // Photopic luminance in cd m^-2 (luminance.csv, the report's profiles):
     // Rec. 709 Y of the images (for a spectral run the CIE 1931 Y, the images
     // being linear sRGB from XYZ) times a scale, per unit of the view's
-    // sun_irradiance: with --wavelengths 683 lm/W x 106.86 nm (the solar
-    // spectrum in W m^-2 nm^-1 makes the images W m^-2 sr^-1 nm^-1); RGB
-    // runs, whose images are radiance per unit solar irradiance, times the
-    // Sun's illuminance at the top of the atmosphere at 1 AU computed from the
-    // ASTM G173 extraterrestrial spectrum (683 x integral of E y dlambda, about
-    // 1.3e5 lx): Y then stands for the sky's luminance under the real Sun,
-    // with the RGB channels taken as the spectrum's luminance-weighted
-    // samples. Radiance only; not with reference_wavelengths.
+    // sun_irradiance. An atmosphere with a tabulated solar spectrum
+    // (HasPhysicalSolarSpectrum: W m^-2 nm^-1) makes the images W m^-2 sr^-1
+    // nm^-1: 683 lm/W x 106.86 nm. Otherwise the images are radiance per unit
+    // solar irradiance: times the Sun's illuminance at the top of the
+    // atmosphere at 1 AU computed from the ASTM G173 extraterrestrial spectrum
+    // (683 x integral of E y dlambda, about 1.33e5 lx). For RGB models Y takes
+    // the three channels as the luminance-weighted samples of the spectrum.
+    // Radiance only; not with reference_wavelengths.
     bool luminance = false;
     std::string command_line;  // for the report
 };
@@ -87,5 +87,9 @@ CompareConfig ResolveCompareConfig(const CompareRequest& request);
 // times the integral of the ASTM G173 extraterrestrial spectrum (W m^-2 nm^-1)
 // against the CIE 1931 y function.
 double SolarIlluminanceLux();
+// The atmosphere's solar spectrum is physical: a spectral file that tabulates
+// it (earth-spectral: ASTM G173, W m^-2 nm^-1); else the images are per unit
+// solar irradiance.
+bool HasPhysicalSolarSpectrum(const SpectralAtmosphere& atmosphere);
 
 }  // namespace atmos
