@@ -83,16 +83,8 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
                     "models (default: all but the reference); NAME:OPTION=VALUE[:...] compares a "
                     "model with options, e.g. hillaire:segment-offset=0.5")
         ->delimiter(',');
-    cmd->add_option("--views", o->request.views,
-                    "views (default: all 12; transmittance: 5): names, and FILE.json files of "
-                    "named custom views {\"NAME\": {\"camera\": \"KEY=VALUE,...\", \"sun\": "
-                    "\"KEY=VALUE,...\"}} in the vocabulary of render --camera and --sun "
-                    "(docs/manual.md)")
-        ->delimiter(',');
-    cmd->add_flag("--luminance", o->request.luminance,
-                  "photopic luminance in cd m^-2: luminance.csv (mean over each image, its sky "
-                  "and its ground) and the report's profiles (docs/manual.md: what it means for "
-                  "RGB models)");
+    cmd->add_option("--views", o->request.views, kCompareViewsHelp)->delimiter(',');
+    cmd->add_flag("--luminance", o->request.luminance, kCompareLuminanceHelp);
     cmd->add_option("--size,-s", o->size, "image size WIDTHxHEIGHT")->capture_default_str();
     cmd->add_option("--quantity", o->request.quantity,
                     "radiance (HDR-FLIP) or transmittance (LDR-FLIP)")

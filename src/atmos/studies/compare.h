@@ -24,6 +24,15 @@ constexpr int64_t kCompareReferenceSpp = 64;
 constexpr double kCompareReferenceNoise = 0.01;
 constexpr int64_t kCompareReferenceCap = 512;
 
+// The help of compare's --views and --luminance (the CLI's flags).
+constexpr const char* kCompareViewsHelp =
+    "views (default: all 12; transmittance: 5): names, and FILE.json files of named custom "
+    "views {\"NAME\": {\"camera\": \"KEY=VALUE,...\", \"sun\": \"KEY=VALUE,...\"}} in the "
+    "vocabulary of render --camera and --sun (docs/manual.md)";
+constexpr const char* kCompareLuminanceHelp =
+    "photopic luminance in cd m^-2: luminance.csv (mean over each image, its sky and its "
+    "ground) and the report's profiles (docs/manual.md: what it means for RGB models)";
+
 struct CompareRequest {
     std::vector<std::string>
         models;  // specs; empty: every model with the quantity but the reference
