@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "atmos/error.h"
+#include "atmos/image.h"
 #include "studies/bench.h"
 #include "studies/compare.h"
 #include "studies/spectral_sample.h"
@@ -223,7 +224,37 @@ TEST(StudiesCompare, RunOnTinyImages) {
         EXPECT_GT(row.cells[1].rmse, 0.0) << row.view;  // constant white is not the sky
     }
     EXPECT_FALSE(r.reference_noise_table);  // a deterministic reference
-    // The tables come from the writer, not from the run.
+    // The run writes nothing (issue 30 item 1): the images are in the result.
+    EXPECT_TRUE(fs::is_empty(config.output_dir));
+    for (const CompareRow& row : r.rows) {
+        EXPECT_EQ(row.reference_image.width(), 8) << row.view;
+        EXPECT_EQ(row.reference_image.height(), 4) << row.view;
+        for (const CompareCell& c : row.cells) {
+            EXPECT_EQ(c.image.size(), row.reference_image.size()) << row.view;
+            EXPECT_EQ(c.flip_map.size(), 8u * 4u) << row.view;
+        }
+        // The reference is the first model: the same pixels.
+        EXPECT_TRUE(std::equal(row.reference_image.data(),
+                               row.reference_image.data() + row.reference_image.size(),
+                               row.cells[0].image.data()))
+            << row.view;
+    }
+    // The images come from their writer, the tables from theirs.
+    WriteCompareImages(config, r);
+    for (const char* file : {"images/space/reference.png", "images/space/reference.exr",
+                             "images/ground-noon/empty.exr", "errors/space/empty-flip.png",
+                             "errors/space/empty-rmse.exr", "errors/space/empty-rmse.png"}) {
+        EXPECT_TRUE(fs::is_regular_file(fs::path(config.output_dir) / file)) << file;
+    }
+    EXPECT_FALSE(fs::exists(fs::path(config.output_dir) / "images/space/empty.npy"));  // !npy
+    {
+        // The written reference is the result's (EXR: float32).
+        const Image read =
+            ReadImage((fs::path(config.output_dir) / "images/ground-noon/reference.exr").string());
+        const Image& kept = r.rows[0].reference_image;
+        ASSERT_EQ(read.size(), kept.size());
+        EXPECT_TRUE(std::equal(kept.data(), kept.data() + kept.size(), read.data()));
+    }
     EXPECT_FALSE(fs::exists(fs::path(config.output_dir) / "flip.csv"));
     WriteCompareTables(config, r);
     const std::string flip = Slurp(fs::path(config.output_dir) / "flip.csv");

@@ -58,6 +58,7 @@ int CmdCompare(CompareCliOptions o) {
     ThreadLimit limit(o.study.threads);
     const BackendScope backend(ParseBackend(o.study.backend));
     const CompareResult r = RunCompare(config);
+    WriteCompareImages(config, r);
     WriteCompareTables(config, r);
     if (!o.study.quiet) {
         std::fprintf(stderr, "compared %zu models at %zu views in %.1f s (%d threads)\n",
@@ -82,8 +83,8 @@ Command AddCompareCommand(CLI::App* root, int argc, char** argv) {
                     "models (default: all but the reference); NAME:OPTION=VALUE[:...] compares a "
                     "model with options, e.g. hillaire:segment-offset=0.5")
         ->delimiter(',');
-    cmd->add_option("--views", o->request.views, "views (default: all 12; transmittance: 5)")
-        ->delimiter(',');
+    cmd->add_option("--views", o->request.views, kCompareViewsHelp)->delimiter(',');
+    cmd->add_flag("--luminance", o->request.luminance, kCompareLuminanceHelp);
     cmd->add_option("--size,-s", o->size, "image size WIDTHxHEIGHT")->capture_default_str();
     cmd->add_option("--quantity", o->request.quantity,
                     "radiance (HDR-FLIP) or transmittance (LDR-FLIP)")

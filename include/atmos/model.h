@@ -45,6 +45,9 @@ struct ModelCapabilities {
     bool spectral = true;
     // `atmos fit` trains its weights against a reference model.
     bool trainable = false;
+    // A baseline that models nothing (`empty`): compare leaves it out of the
+    // Pareto front and of the verdict per regime.
+    bool baseline = false;
     // The WebGL2 shader (shaders/NAME.glsl, without the directory) that draws
     // its baked tables in `atmos viewer`; empty: none. The models with one are
     // the viewer's default list, in registry order.

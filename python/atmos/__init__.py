@@ -563,17 +563,28 @@ def validate(models=None, *, data=None, atmosphere=None, sets=None, captures=Non
 def compare(output_dir, models=None, *, views=None, size=(320, 180), quantity="radiance",
             reference=None, reference_spp=None, reference_seed=None, reference_noise=None,
             atmosphere="earth", sets=None, cache=None, no_cache=False,
-            shipped_references=True, npy=True, progress=False):
+            shipped_references=True, npy=True, progress=False, luminance=False):
     """The compare study, as `atmos compare -o output_dir`: every model against the
     reference (default: the path tracer) at the views; writes the same images,
-    tables and index.html. Returns a dict: models, views, reference, flip and rmse
-    (views x models), reference_noise and reference_spp (per view), output_dir."""
+    tables and index.html. views: names of the 12 and views files (NAME.json), or
+    a dict of custom views {name: {"camera": ..., "sun": ...}} (the file's
+    format, docs/manual.md). luminance: photopic luminance in cd m^-2 (as
+    --luminance). Returns a dict: models, views, reference, flip and rmse (views x
+    models), flip_sky, flip_ground, rmse_sky, rmse_ground (NaN where a view has no
+    such pixels), reference_noise and reference_spp (per view), regimes (one dict
+    per regime), luminance and reference_luminance (with luminance), output_dir."""
     width, height = size
-    return _atmos.compare(_list(models), _list(views), int(width), int(height), quantity,
+    views_json = ""
+    if isinstance(views, dict):
+        import json as _json
+        views_json, views = _json.dumps(views), None
+    return _atmos.compare(_list(models), _list(views), views_json, int(width), int(height),
+                          quantity,
                           reference, reference_spp, reference_seed, reference_noise, atmosphere,
                           _list(sets), _os.fspath(output_dir),
                           _os.fspath(cache) if cache is not None else None, bool(no_cache),
-                          bool(shipped_references), bool(npy), bool(progress))
+                          bool(shipped_references), bool(npy), bool(progress),
+                          bool(luminance))
 
 
 def bench(models=None, *, views=None, size=(480, 270), quantity="radiance", repeat=None,

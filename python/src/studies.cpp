@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "base/parallel.h"
+#include "harness/regimes.h"
 #include "render/progressive.h"
 #include "studies/bench.h"
 #include "studies/compare.h"
@@ -85,17 +86,52 @@ py::dict CompareDict(const CompareConfig& config, const CompareResult& r) {
     d["reference"] = config.reference_model;
     d["output_dir"] = config.output_dir;
     std::vector<std::string> views;
-    std::vector<double> flip, rmse, noise;
+    std::vector<double> flip, rmse, noise, flip_sky, flip_ground, rmse_sky, rmse_ground, lum,
+        ref_lum;
     std::vector<int64_t> spp;
     for (const CompareRow& row : r.rows) {
         views.push_back(row.view);
         noise.push_back(row.reference_noise);
         spp.push_back(row.reference_spp);
+        ref_lum.push_back(row.reference_luminance.all);
         for (const CompareCell& c : row.cells) {
             flip.push_back(c.flip);
             rmse.push_back(c.rmse);
+            flip_sky.push_back(c.flip_sky);
+            flip_ground.push_back(c.flip_ground);
+            rmse_sky.push_back(c.rmse_sky);
+            rmse_ground.push_back(c.rmse_ground);
+            lum.push_back(c.luminance.all);
         }
     }
+    const size_t nv = r.rows.size(), nm = r.models.size();
+    d["flip_sky"] = Array2d(flip_sky, nv, nm);
+    d["flip_ground"] = Array2d(flip_ground, nv, nm);
+    d["rmse_sky"] = Array2d(rmse_sky, nv, nm);
+    d["rmse_ground"] = Array2d(rmse_ground, nv, nm);
+    if (config.luminance) {
+        d["luminance"] = Array2d(lum, nv, nm);
+        d["reference_luminance"] =
+            py::array_t<double>(static_cast<py::ssize_t>(ref_lum.size()), ref_lum.data());
+    }
+    py::list regimes;
+    for (const RegimeVerdict& v : JudgeRegimes(r)) {
+        py::dict e;
+        e["kind"] = v.kind;
+        e["regime"] = v.regime;
+        e["views"] = v.views;
+        std::vector<std::string> best;
+        for (int m : v.best) best.push_back(r.models[static_cast<size_t>(m)]);
+        e["best"] = best;
+        e["flip"] = v.flip;
+        e["frame_seconds"] = v.frame_seconds;
+        e["precompute_seconds"] = v.precompute_seconds;
+        e["machine"] = CostMachine(config, r);
+        e["reference_noise"] = v.reference_noise;
+        e["excluded"] = v.excluded;
+        regimes.append(e);
+    }
+    d["regimes"] = regimes;
     d["views"] = views;
     d["flip"] = Array2d(flip, r.rows.size(), r.models.size());
     d["rmse"] = Array2d(rmse, r.rows.size(), r.models.size());
@@ -192,16 +228,17 @@ void BindStudies(py::module_& mod) {
         py::arg("fit_evaluations"), py::arg("fit_second_lobe"));
     mod.def(
         "compare",
-        [](const std::vector<std::string>& models, const std::vector<std::string>& views, int width,
-           int height, const std::string& quantity, std::optional<std::string> reference,
-           std::optional<int64_t> reference_spp, std::optional<int64_t> reference_seed,
-           std::optional<double> reference_noise, const std::string& atmosphere,
-           const std::vector<std::string>& sets, const std::string& output_dir,
-           std::optional<std::string> cache_dir, bool no_cache, bool shipped_references,
-           bool write_npy, bool progress) {
+        [](const std::vector<std::string>& models, const std::vector<std::string>& views,
+           const std::string& views_json, int width, int height, const std::string& quantity,
+           std::optional<std::string> reference, std::optional<int64_t> reference_spp,
+           std::optional<int64_t> reference_seed, std::optional<double> reference_noise,
+           const std::string& atmosphere, const std::vector<std::string>& sets,
+           const std::string& output_dir, std::optional<std::string> cache_dir, bool no_cache,
+           bool shipped_references, bool write_npy, bool progress, bool luminance) {
             CompareRequest q;
             q.models = models;
             q.views = views;
+            q.views_json = views_json;
             q.width = width;
             q.height = height;
             q.quantity = quantity;
@@ -217,21 +254,24 @@ void BindStudies(py::module_& mod) {
             q.no_shipped = !shipped_references;
             q.write_npy = write_npy;
             q.show_progress = progress;
+            q.luminance = luminance;
             q.command_line = "atmos.compare (Python)";
             const CompareConfig config = ResolveCompareConfig(q);
             CompareResult r;
             {
                 py::gil_scoped_release release;
                 r = RunCompare(config);
+                WriteCompareImages(config, r);
                 WriteCompareTables(config, r);
             }
             return CompareDict(config, r);
         },
-        py::arg("models"), py::arg("views"), py::arg("width"), py::arg("height"),
-        py::arg("quantity"), py::arg("reference"), py::arg("reference_spp"),
+        py::arg("models"), py::arg("views"), py::arg("views_json"), py::arg("width"),
+        py::arg("height"), py::arg("quantity"), py::arg("reference"), py::arg("reference_spp"),
         py::arg("reference_seed"), py::arg("reference_noise"), py::arg("atmosphere"),
         py::arg("sets"), py::arg("output_dir"), py::arg("cache_dir"), py::arg("no_cache"),
-        py::arg("shipped_references"), py::arg("write_npy"), py::arg("progress"));
+        py::arg("shipped_references"), py::arg("write_npy"), py::arg("progress"),
+        py::arg("luminance"));
     mod.def(
         "bench",
         [](const std::vector<std::string>& models, const std::vector<std::string>& views, int width,

@@ -53,6 +53,27 @@ def test_compare_returns_the_tables(tmp):
     assert float(flip_csv[1].split(",")[1]) == pytest.approx(r["flip"][0, 0], rel=1e-7)
 
 
+def test_compare_custom_views_regions_regimes_and_luminance(tmp):
+    views = {"sky-5deg": {"camera": {"projection": "equirect"},
+                          "sun": {"elevation": 5, "azimuth": 90}}}
+    r = atmos.compare(tmp / "custom", ["naive:steps=8", "empty"], views=views, size=(8, 4),
+                      reference="naive:steps=8", no_cache=True, npy=False, luminance=True)
+    assert r["views"] == ["sky-5deg"]
+    # The reference itself: zero over the sky and the ground alike.
+    assert r["flip_sky"][0, 0] == 0 and r["rmse_ground"][0, 0] == 0
+    assert r["rmse_sky"][0, 1] > 0
+    # empty is grey, 1 per unit irradiance: the Sun's illuminance per steradian (~1.3e5).
+    assert 1.2e5 < r["luminance"][0, 1] < 1.4e5
+    assert r["reference_luminance"][0] == pytest.approx(r["luminance"][0, 0])
+    assert [(g["kind"], g["regime"]) for g in r["regimes"]] == [("place", "ground"),
+                                                                ("light", "sunrise")]
+    assert r["regimes"][0]["best"] == ["naive:steps=8"]  # empty: a baseline, left out
+    assert (tmp / "custom" / "regimes.csv").exists()
+    with pytest.raises(ValueError, match="view 'x', camera: fov must be in"):
+        atmos.compare(tmp / "bad", ["empty"], views={"x": {"camera": "fov=200", "sun": "elevation=5"}},
+                      size=(8, 4), reference="naive:steps=8", no_cache=True)
+
+
 def test_bench_times_each_model_and_view():
     r = atmos.bench(["flat", "empty"], views=["ground-noon"], size=(8, 4), repeat=2, warmup=0)
     assert [(row["model"], row["view"]) for row in r["rows"]] == [

@@ -11,7 +11,9 @@
 
 #include "atmos/error.h"
 #include "base/parallel.h"
+#include "harness/compare_regions.h"
 #include "harness/ranking.h"
+#include "harness/regimes.h"
 #include "harness/render_cache.h"
 #include "harness/report.h"
 #include "harness/shipped_references.h"
@@ -28,6 +30,8 @@ namespace {
 double SecondsSince(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
+
+std::string CacheViewName(const View& view);
 
 // A model's images, rendered on demand: Prepare() runs once, only if some
 // image is not in the cache.
@@ -57,7 +61,7 @@ class LazyRenderer {
     Image Render(const View& view, double* seconds, bool* cached,
                  MonteCarloReport* report = nullptr, Image* variance = nullptr) {
         RenderKey key = key_;
-        key.view = view.name;
+        key.view = CacheViewName(view);
         Image image;
         MonteCarloReport local;
         if (!report) report = &local;
@@ -196,6 +200,22 @@ class LazyRenderer {
     int64_t table_bytes_ = -1;
 };
 
+// The render cache's name of a view: a named view's name; a custom view's
+// name and a hash of its geometry (the same name may mean another camera in
+// another views file).
+std::string CacheViewName(const View& view) {
+    const std::vector<std::string> names = StandardViewNames();
+    if (std::find(names.begin(), names.end(), view.name) != names.end()) return view.name;
+    std::string text = ViewFingerprintText(view);
+    text += "projection " + std::to_string(static_cast<int>(view.camera.projection)) + "\n";
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "half_fov %.17g\nlimb %.17g\n", view.camera.half_fov,
+                  view.sun_limb_darkening);
+    text += buf;
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(Fnv1a64(text)));
+    return view.name + "-" + buf;
+}
+
 std::string FileStem(const std::string& name) {
     std::string s;
     for (char c : name) {
@@ -204,6 +224,14 @@ std::string FileStem(const std::string& name) {
         s += ok ? c : '_';
     }
     return s;
+}
+
+CompareLuminance ScaledLuminance(const RegionLuminance& y, double scale) {
+    CompareLuminance l;
+    l.all = y.all * scale;
+    l.sky = y.sky * scale;
+    l.ground = y.ground * scale;
+    return l;
 }
 
 void WriteImages(const Image& image, const fs::path& dir, const std::string& stem, float exposure,
@@ -328,10 +356,13 @@ CompareResult RunCompare(const CompareConfig& config) {
     const std::vector<std::string> view_names =
         config.views.empty() ? DefaultCompareViews(config.quantity) : config.views;
     std::vector<View> views;
-    for (const std::string& v : view_names) views.push_back(GetView(v, config.atmosphere));
+    for (const std::string& v : view_names) {
+        const auto custom = std::find_if(config.custom_views.begin(), config.custom_views.end(),
+                                         [&](const View& c) { return c.name == v; });
+        views.push_back(custom != config.custom_views.end() ? *custom
+                                                            : GetView(v, config.atmosphere));
+    }
 
-    const fs::path out(config.output_dir);
-    fs::create_directories(out);
     const RenderCache cache(config.cache_dir);
     // A Monte Carlo reference: two independent halves, averaged (the same
     // number of paths), whose difference measures its noise.
@@ -401,11 +432,14 @@ CompareResult RunCompare(const CompareConfig& config) {
         row.view = view.name;
         row.label = CompareRowLabel(view.name, config.quantity);
         row.description = view.description;
-        const float exposure = transmittance ? 1.0f : view.exposure;
-        const fs::path image_dir = out / "images" / FileStem(view.name);
-        const fs::path error_dir = out / "errors" / FileStem(view.name);
-        fs::create_directories(image_dir);
-        fs::create_directories(error_dir);
+        row.exposure = transmittance ? 1.0f : view.exposure;
+        row.place = PlaceRegime(view, config.atmosphere);
+        row.light = LightRegime(view, config.atmosphere);
+        const std::vector<uint8_t> mask =
+            RegionMask(view, config.width, config.height, config.atmosphere.bottom_radius);
+        const RegionCounts counts = CountRegions(mask);
+        row.sky_pixels = counts.sky;
+        row.ground_pixels = counts.ground;
         MonteCarloReport ref_report;
         Image ref_variance;  // per-pixel variance of the reference's estimate (may stay empty)
         Image ref;
@@ -441,7 +475,11 @@ CompareResult RunCompare(const CompareConfig& config) {
             bool cached_b = false;
             Image variance_b;
             const Image b = reference_b.Render(view, &seconds_b, &cached_b, nullptr, &variance_b);
-            row.reference_noise = HdrFlip(ref, b, config.flip).mean;
+            const FlipResult halves = HdrFlip(ref, b, config.flip);
+            row.reference_noise = halves.mean;
+            const RegionValues noise = RegionMean(halves.map, mask);
+            row.reference_noise_sky = std::isfinite(noise.sky) ? noise.sky : -1.0;
+            row.reference_noise_ground = std::isfinite(noise.ground) ? noise.ground : -1.0;
             const float wa = static_cast<float>(spp_a) / static_cast<float>(spp_a + spp_b);
             // The variance of the weighted mean: from the halves' own estimates,
             // else from their difference (E[(a - b)^2] = var_a + var_b).
@@ -470,10 +508,24 @@ CompareResult RunCompare(const CompareConfig& config) {
             for (size_t i = 0; i < ref_variance.size(); ++i)
                 sum += static_cast<double>(ref_variance.data()[i]);
             row.reference_rmse_noise = 2.0 * std::sqrt(sum / static_cast<double>(ref.size()));
+            const RegionValues noise = RegionRmseNoise(ref_variance, mask);
+            row.reference_rmse_noise_sky = noise.sky;
+            row.reference_rmse_noise_ground = noise.ground;
         } else {
             ref_variance = Image();
         }
-        if (!transmittance) {
+        {
+            const RegionLuminance y = MeanLuminance(ref, mask);
+            row.reference_mean_sky = y.sky;
+            row.reference_mean_ground = y.ground;
+        }
+        if (config.luminance) {
+            row.luminance_scale = config.luminance_scale / view.sun_irradiance;
+            row.reference_luminance =
+                ScaledLuminance(MeanLuminance(ref, mask), row.luminance_scale);
+        }
+        // Profiles: along lines of a perspective image (profiles.h).
+        if (!transmittance && view.camera.projection == Projection::kPerspective) {
             for (const ProfileLine& line :
                  ViewProfileLines(view, config.width, config.height,
                                   config.atmosphere.bottom_radius, config.atmosphere.top_radius)) {
@@ -485,13 +537,12 @@ CompareResult RunCompare(const CompareConfig& config) {
                 row.profiles.push_back(std::move(profile));
             }
         }
-        Image rgb_ref;
         if (spectral_reference) {
             bool cached_rgb = false;
-            rgb_ref = rgb_reference.Render(view, &row.rgb_reference_seconds, &cached_rgb);
-            WriteImages(rgb_ref, image_dir, "reference-rgb", exposure, config.write_npy);
+            row.rgb_reference_image =
+                rgb_reference.Render(view, &row.rgb_reference_seconds, &cached_rgb);
         }
-        WriteImages(ref, image_dir, "reference", exposure, config.write_npy);
+        const Image& rgb_ref = row.rgb_reference_image;
         row.reference_png = (fs::path("images") / FileStem(view.name) / "reference.png").string();
         if (config.show_progress) {
             std::fprintf(stderr, "%-22s reference (%s) %s %.3f s", view.name.c_str(),
@@ -515,24 +566,29 @@ CompareResult RunCompare(const CompareConfig& config) {
             const std::string& name = result.models[m];
             const std::string stem = FileStem(name);
             CompareCell cell;
-            const Image img = renderers[m]->Render(view, &cell.render_seconds, &cell.cached);
-            WriteImages(img, image_dir, stem, exposure, config.write_npy);
-            const FlipResult flip =
+            cell.image = renderers[m]->Render(view, &cell.render_seconds, &cell.cached);
+            const Image& img = cell.image;
+            FlipResult flip =
                 transmittance ? LdrFlip(ref, img, config.flip) : HdrFlip(ref, img, config.flip);
             const RmseResult rmse = ComputeRmse(ref, img);
             cell.flip = flip.mean;
             cell.rmse = rmse.overall;
+            const RegionValues flip_regions = RegionMean(flip.map, mask);
+            const RegionValues rmse_regions = RegionRmse(ref, img, mask);
+            cell.flip_sky = flip_regions.sky;
+            cell.flip_ground = flip_regions.ground;
+            cell.rmse_sky = rmse_regions.sky;
+            cell.rmse_ground = rmse_regions.ground;
+            if (config.luminance) {
+                cell.luminance = ScaledLuminance(MeanLuminance(img, mask), row.luminance_scale);
+            }
             if (spectral_reference)
                 cell.flip_rgb_reference = HdrFlip(rgb_ref, img, config.flip).mean;
             for (CompareRow::Profile& profile : row.profiles) {
                 profile.models.push_back(ProfileLuminance(img, profile.line));
             }
             cell.within_noise = row.reference_noise >= 0.0 && cell.flip <= row.reference_noise;
-            WriteColorMappedPng(flip.map, flip.width, flip.height,
-                                (error_dir / (stem + "-flip.png")).string());
-            const Image abs_error = AbsoluteErrorImage(ref, img);
-            WriteImage(abs_error, (error_dir / (stem + "-rmse.exr")).string());
-            WriteImage(abs_error, (error_dir / (stem + "-rmse.png")).string(), exposure);
+            cell.flip_map = std::move(flip.map);
             cell.validity_note = ValidityNote(GetModelInfo(result.model_names[m]).capabilities,
                                               view, config.atmosphere);
             cell.image_png = (fs::path("images") / FileStem(view.name) / (stem + ".png")).string();
@@ -550,9 +606,10 @@ CompareResult RunCompare(const CompareConfig& config) {
                 }
                 std::fprintf(stderr, "\n");
             }
-            row.cells.push_back(cell);
+            row.cells.push_back(std::move(cell));
         }
-        result.rows.push_back(row);
+        row.reference_image = std::move(ref);
+        result.rows.push_back(std::move(row));
     }
     for (const auto& r : renderers) {
         r->LoadPrepareRecord();
@@ -578,6 +635,31 @@ CompareResult RunCompare(const CompareConfig& config) {
     return result;
 }
 
+void WriteCompareImages(const CompareConfig& config, const CompareResult& r) {
+    const fs::path out(config.output_dir);
+    for (const CompareRow& row : r.rows) {
+        const fs::path image_dir = out / "images" / FileStem(row.view);
+        const fs::path error_dir = out / "errors" / FileStem(row.view);
+        fs::create_directories(image_dir);
+        fs::create_directories(error_dir);
+        if (row.rgb_reference_image.size() > 0) {
+            WriteImages(row.rgb_reference_image, image_dir, "reference-rgb", row.exposure,
+                        config.write_npy);
+        }
+        WriteImages(row.reference_image, image_dir, "reference", row.exposure, config.write_npy);
+        for (size_t m = 0; m < row.cells.size() && m < r.models.size(); ++m) {
+            const CompareCell& cell = row.cells[m];
+            const std::string stem = FileStem(r.models[m]);
+            WriteImages(cell.image, image_dir, stem, row.exposure, config.write_npy);
+            WriteColorMappedPng(cell.flip_map, cell.image.width(), cell.image.height(),
+                                (error_dir / (stem + "-flip.png")).string());
+            const Image abs_error = AbsoluteErrorImage(row.reference_image, cell.image);
+            WriteImage(abs_error, (error_dir / (stem + "-rmse.exr")).string());
+            WriteImage(abs_error, (error_dir / (stem + "-rmse.png")).string(), row.exposure);
+        }
+    }
+}
+
 void WriteCompareTables(const CompareConfig& config, const CompareResult& r) {
     const fs::path out(config.output_dir);
     fs::create_directories(out);
@@ -599,6 +681,77 @@ void WriteCompareTables(const CompareConfig& config, const CompareResult& r) {
     }
     WriteMetricCsv((out / "flip.csv").string(), "FLIP errors", labels, r.models, flips, flip_noise);
     WriteMetricCsv((out / "rmse.csv").string(), "RMSE errors", labels, r.models, rmses, rmse_noise);
+    // Sky and ground apart (issue 33 item 2): flip.csv's layout over each
+    // region's pixels; ties within the region's reference noise where it is
+    // measured, else the whole image's.
+    for (const bool ground : {false, true}) {
+        std::vector<std::vector<double>> f, e;
+        std::vector<double> fn, en;
+        for (const CompareRow& row : r.rows) {
+            std::vector<double> fr, er;
+            for (const CompareCell& c : row.cells) {
+                fr.push_back(ground ? c.flip_ground : c.flip_sky);
+                er.push_back(ground ? c.rmse_ground : c.rmse_sky);
+            }
+            f.push_back(fr);
+            e.push_back(er);
+            const double noise = ground ? row.reference_noise_ground : row.reference_noise_sky;
+            fn.push_back(noise >= 0.0 ? noise : row.reference_noise);
+            en.push_back(ground ? row.reference_rmse_noise_ground : row.reference_rmse_noise_sky);
+        }
+        const std::string region = ground ? "ground" : "sky";
+        WriteMetricCsv((out / ("flip_" + region + ".csv")).string(), "FLIP errors (" + region + ")",
+                       labels, r.models, f, fn);
+        WriteMetricCsv((out / ("rmse_" + region + ".csv")).string(), "RMSE errors (" + region + ")",
+                       labels, r.models, e, en);
+    }
+    {
+        // The reference's noise and mean per region (empty: not measured, or no pixels).
+        TextOutput f((out / "reference_noise_regions.csv").string());
+        f << "view,sky_pixels,ground_pixels,flip_noise,flip_noise_sky,flip_noise_ground,"
+             "rmse_noise,rmse_noise_sky,rmse_noise_ground,mean_luminance_sky,"
+             "mean_luminance_ground\n";
+        auto number = [](double v, bool known) {
+            char buf[32];
+            std::snprintf(buf, sizeof buf, "%.8g", v);
+            return known && std::isfinite(v) ? std::string(buf) : std::string();
+        };
+        for (const CompareRow& row : r.rows) {
+            f << row.label << "," << row.sky_pixels << "," << row.ground_pixels << ","
+              << number(row.reference_noise, row.reference_noise >= 0.0) << ","
+              << number(row.reference_noise_sky, row.reference_noise_sky >= 0.0) << ","
+              << number(row.reference_noise_ground, row.reference_noise_ground >= 0.0) << ","
+              << number(row.reference_rmse_noise, row.reference_rmse_noise >= 0.0) << ","
+              << number(row.reference_rmse_noise_sky, row.reference_rmse_noise_sky >= 0.0) << ","
+              << number(row.reference_rmse_noise_ground, row.reference_rmse_noise_ground >= 0.0)
+              << "," << number(row.reference_mean_sky, row.sky_pixels > 0) << ","
+              << number(row.reference_mean_ground, row.ground_pixels > 0) << "\n";
+        }
+        f.Commit();
+    }
+    if (config.luminance) {
+        // Mean photopic luminance (cd m^-2) over the image and each region.
+        TextOutput f((out / "luminance.csv").string());
+        f << "view,region,reference";
+        for (const std::string& m : r.models) f << "," << m;
+        f << "\n";
+        for (const CompareRow& row : r.rows) {
+            for (const char* region : {"all", "sky", "ground"}) {
+                const std::string g = region;
+                auto pick = [&](const CompareLuminance& l) {
+                    const double v = g == "all" ? l.all : g == "sky" ? l.sky : l.ground;
+                    char buf[32];
+                    std::snprintf(buf, sizeof buf, "%.8g", v);
+                    return std::isfinite(v) ? std::string(buf) : std::string();
+                };
+                f << row.label << "," << g << "," << pick(row.reference_luminance);
+                for (const CompareCell& c : row.cells) f << "," << pick(c.luminance);
+                f << "\n";
+            }
+        }
+        f.Commit();
+    }
+    WriteRegimesCsv((out / "regimes.csv").string(), config, r);
     if (r.reference_noise_table) {
         // source: rendered, cached or shipped (then provenance: its provenance.json).
         TextOutput f((out / "reference_noise.csv").string());

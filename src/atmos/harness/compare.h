@@ -3,12 +3,14 @@
 // sections 11.5-11.7 and Appendix A-D).
 //
 // For each view and model: render (or load from the render cache) the
-// reference and the model, write the images (PNG, EXR, NPY), the FLIP error
-// map (colour-mapped PNG) and the RMSE map (per-channel |difference|, EXR and
-// PNG), and collect FLIP and RMSE into tables laid out like the thesis's
+// reference and the model, keep the images and the FLIP error map in the
+// result, and collect FLIP and RMSE into tables laid out like the thesis's
 // appendices: rows = views, columns = models, the best (lowest) of each row
 // named in a last column "best". Radiance uses HDR-FLIP on the linear images;
-// transmittance uses LDR-FLIP (values in [0, 1]), as the thesis did.
+// transmittance uses LDR-FLIP (values in [0, 1]), as the thesis did. The run
+// does no file output (the render cache aside); the writers below write the
+// images (PNG, EXR, NPY), the FLIP map (colour-mapped PNG), the error image
+// (per-channel |difference|, EXR and PNG), the tables and the report from it.
 #pragma once
 
 #include <map>
@@ -30,6 +32,9 @@ struct CompareConfig {
     std::vector<std::string>
         models;  // empty: every registered model with the quantity, but Monte Carlo ones
     std::vector<std::string> views;  // empty: DefaultCompareViews(quantity)
+    // Custom views (--views FILE.json, studies/compare_views.h) for
+    // `atmosphere`: `views` names them among the 12 named ones.
+    std::vector<View> custom_views;
     int width = 320;
     int height = 180;
     Quantity quantity = Quantity::kRadiance;
@@ -69,6 +74,22 @@ struct CompareConfig {
     bool write_npy = true;
     bool show_progress = true;
     std::string command_line;  // for the report
+    // --luminance: each image's mean photopic luminance (luminance.csv, the
+    // report) and the profiles in cd m^-2: Rec. 709 Y of the image times
+    // luminance_scale / the view's sun_irradiance (studies/compare.h says what
+    // the scale is for RGB and spectral runs; luminance_note says it in the report).
+    bool luminance = false;
+    double luminance_scale = 0.0;
+    std::string luminance_note;
+    // How the models rendered, for the cost columns: "CPU" or "CUDA GPU".
+    std::string machine = "CPU";
+};
+
+// Mean luminance over the image and its regions (--luminance: cd m^-2).
+struct CompareLuminance {
+    double all = -1.0;
+    double sky = -1.0;
+    double ground = -1.0;
 };
 
 struct CompareCell {
@@ -78,13 +99,22 @@ struct CompareCell {
     // --reference-wavelengths: HDR-FLIP against the RGB reference (else < 0).
     double flip_rgb_reference = -1.0;
     bool cached = false;
-    std::string validity_note;  // non-empty: the view is outside the model's declared validity
+    // Sky and ground apart (harness/compare_regions.h): FLIP and RMSE over
+    // the sky and over the ground pixels (NaN when the view has none).
+    double flip_sky = 0.0, flip_ground = 0.0;
+    double rmse_sky = 0.0, rmse_ground = 0.0;
+    CompareLuminance luminance;  // --luminance
+    std::string validity_note;   // non-empty: the view is outside the model's declared validity
     // FLIP at or below the row's reference_noise: the difference to the
     // reference is not resolved by it.
     bool within_noise = false;
     std::string image_png;  // paths relative to the output directory
     std::string flip_png;
     std::string rmse_png;
+    // The model's image and its per-pixel FLIP map against the reference
+    // (width x height, row-major; WriteCompareImages writes them).
+    Image image;
+    std::vector<float> flip_map;
 };
 
 struct CompareRow {
@@ -92,6 +122,11 @@ struct CompareRow {
     std::string label;  // the table's row label (transmittance: ground, plane, ...)
     std::string description;
     std::string reference_png;
+    float exposure = 1.0f;  // the view's PNG exposure (transmittance: 1)
+    // The reference's image and, with --reference-wavelengths, the RGB
+    // reference's (else empty); WriteCompareImages writes them.
+    Image reference_image;
+    Image rgb_reference_image;
     double reference_seconds = 0.0;
     bool reference_cached = false;
     // Where the reference came from: "rendered", "cached" or "shipped"
@@ -111,6 +146,18 @@ struct CompareRow {
     // variance of its estimate): its noise in RMSE units, the tie tolerance of
     // the RMSE table. Negative when not known.
     double reference_rmse_noise = -1.0;
+    // Sky and ground: pixel counts; the reference's noise per region: FLIP
+    // between its halves (measured only for a fixed-spp split reference; else
+    // < 0) and twice its RMS standard error (< 0 when not known); its mean
+    // luminance (Rec. 709 Y, image units) per region.
+    int64_t sky_pixels = 0, ground_pixels = 0;
+    double reference_noise_sky = -1.0, reference_noise_ground = -1.0;
+    double reference_rmse_noise_sky = -1.0, reference_rmse_noise_ground = -1.0;
+    double reference_mean_sky = 0.0, reference_mean_ground = 0.0;
+    CompareLuminance reference_luminance;  // --luminance
+    double luminance_scale = 0.0;          // --luminance: cd m^-2 per unit Y of this view's images
+    // The view's regimes (harness/regimes.h): where the camera is, how the sun lights it.
+    std::string place, light;
     std::vector<CompareCell> cells;  // one per model, in CompareResult::models order
     // Luminance along the column through the sun and the row above the
     // horizon (profiles.h): the reference, its standard deviation (empty when
@@ -159,11 +206,18 @@ std::string ValidityNote(const ModelCapabilities& caps, const View& view,
 // (e.g. `hillaire:segment-offset=0.5`), so that variants of one model are
 // compared side by side; the spec text names the model's column and files.
 
-// Runs the comparison (studies/compare.h resolves the config) and writes each
-// view's images and error maps into config.output_dir as it goes (they are too
-// large to keep); the tables and the report are WriteCompareTables'. Throws
-// atmos::Error.
+// Runs the comparison (studies/compare.h resolves the config) and returns its
+// plain data, images included: it writes no file but the render cache's
+// (config.cache_dir), and prints progress lines to stderr with
+// config.show_progress. The images cost 4 bytes per channel and pixel: at the
+// default 320x180, 12 views and 11 models about 12 x (12 x 0.69 + 11 x 0.23)
+// MB = 130 MB; at 1920x1080 about 4.7 GB. Throws atmos::Error.
 CompareResult RunCompare(const CompareConfig& config);
+// Writes each view's images into config.output_dir: images/VIEW/reference,
+// reference-rgb (--reference-wavelengths) and each model (.png at the view's
+// exposure, .exr, .npy unless !write_npy), errors/VIEW/MODEL-flip.png (the FLIP
+// map, magma), MODEL-rmse.exr and .png (|model - reference|). Only reads `result`.
+void WriteCompareImages(const CompareConfig& config, const CompareResult& result);
 // The writers of a result: flip.csv, rmse.csv, times.csv, reference_noise.csv
 // (when measured), rgb_cost.csv (reference_wavelengths), accuracy_cost.csv and
 // index.html in config.output_dir. They only read `result`.

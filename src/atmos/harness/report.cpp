@@ -12,6 +12,7 @@
 #include "harness/html.h"
 #include "harness/machine.h"
 #include "harness/ranking.h"
+#include "harness/regimes.h"
 #include "harness/svg.h"
 #include "io/output_path.h"
 #include "metrics/flip.h"
@@ -220,8 +221,11 @@ void SummaryTable(std::ostream& f, const CompareConfig& config, const CompareRes
           << (s.prepare_seconds > 0.0 ? Duration(s.prepare_seconds) : std::string("&ndash;"))
           << "</td><td>" << Bytes(s.table_bytes) << "</td><td>"
           << (s.lines >= 0 ? std::to_string(s.lines) : std::string("&ndash;")) << "</td><td>"
-          << (s.pareto ? "yes" : "") << "</td><td style=\"text-align:left;white-space:normal\">"
-          << HtmlEscape(s.validity) << "</td></tr>\n";
+          << (s.pareto                 ? "yes"
+              : s.pareto_apart.empty() ? ""
+                                       : "apart: " + s.pareto_apart)
+          << "</td><td style=\"text-align:left;white-space:normal\">" << HtmlEscape(s.validity)
+          << "</td></tr>\n";
     }
     f << "</table>\n";
 }
@@ -276,7 +280,8 @@ void AccuracyCostPlot(std::ostream& f, const CompareConfig& config, const Compar
     // The Pareto front: a staircase through the non-dominated points.
     std::vector<double> cost, error;
     for (const CompareSummary& s : summary) {
-        cost.push_back(s.frame_seconds > 0.0 ? s.frame_seconds : std::nan(""));
+        cost.push_back(s.frame_seconds > 0.0 && s.pareto_apart.empty() ? s.frame_seconds
+                                                                       : std::nan(""));
         error.push_back(s.mean_flip);
     }
     const std::vector<int> front = ParetoFront(cost, error);
@@ -300,9 +305,10 @@ void AccuracyCostPlot(std::ostream& f, const CompareConfig& config, const Compar
         const double px = x.Map(s.frame_seconds), py = y.Map(s.mean_flip);
         const std::string colour = SeriesColour(m);
         const std::string tip =
-            s.model + ": mean FLIP " + General(s.mean_flip, 4) + ", worst " +
-            General(s.worst_flip, 4) + " (" + s.worst_view + "), " + Duration(s.frame_seconds) +
-            " per frame" +
+            s.model +
+            (s.pareto_apart.empty() ? "" : " (apart from the front: " + s.pareto_apart + ")") +
+            ": mean FLIP " + General(s.mean_flip, 4) + ", worst " + General(s.worst_flip, 4) +
+            " (" + s.worst_view + "), " + Duration(s.frame_seconds) + " per frame" +
             (s.prepare_seconds > 0.0 ? ", precompute " + Duration(s.prepare_seconds)
                                      : std::string()) +
             ", rank " + std::to_string(s.rank);
@@ -320,8 +326,10 @@ void AccuracyCostPlot(std::ostream& f, const CompareConfig& config, const Compar
               << "," << Fixed(py - 6, 1) << " l6,6 l-6,6 l-6,-6 z\" fill=\"none\" "
               << "stroke=\"" << colour << "\"/>";
         }
+        // Models apart from the front (a baseline, outside their validity): hollow.
         f << "<circle cx=\"" << Fixed(px, 1) << "\" cy=\"" << Fixed(py, 1) << "\" r=\"5\" fill=\""
-          << colour << "\" stroke=\"#111\"/></g>\n";
+          << (s.pareto_apart.empty() ? colour : "none") << "\" stroke=\""
+          << (s.pareto_apart.empty() ? "#111" : colour) << "\"/></g>\n";
     }
     // Legend, right of the plot (names next to points would collide).
     for (size_t m = 0; m < summary.size(); ++m) {
@@ -329,12 +337,85 @@ void AccuracyCostPlot(std::ostream& f, const CompareConfig& config, const Compar
         f << "<circle cx=\"" << right + 20 << "\" cy=\"" << ly << "\" r=\"4\" fill=\""
           << SeriesColour(m) << "\"/><text x=\"" << right + 30 << "\" y=\"" << ly + 4
           << "\" fill=\"#ccc\" font-size=\"11\">" << HtmlEscape(summary[m].model)
-          << (summary[m].pareto ? " *" : "") << "</text>\n";
+          << (summary[m].pareto ? " *" : "") << (summary[m].pareto_apart.empty() ? "" : " (apart)")
+          << "</text>\n";
     }
     f << "<text x=\"" << right + 20 << "\" y=\""
       << top + 14.0 * static_cast<double>(summary.size()) + 14
-      << "\" fill=\"#888\" font-size=\"10\">* on the Pareto front (green)</text>\n";
+      << "\" fill=\"#888\" font-size=\"10\">* on the Pareto front (green); hollow, apart: "
+         "a baseline or outside its validity</text>\n";
     f << "</svg>\n";
+}
+
+// The verdict per regime (regimes.h): the report's first table.
+void RegimeTable(std::ostream& f, const CompareConfig& config, const CompareResult& r) {
+    const std::vector<RegimeVerdict> verdicts = JudgeRegimes(r);
+    if (verdicts.empty()) return;
+    const std::string size = std::to_string(config.width) + "x" + std::to_string(config.height);
+    f << "<table class=\"summary\" id=\"regimes\"><caption>Which model where: per regime, the "
+         "best model(s) by mean FLIP over its views, tied within the reference's mean noise "
+         "there (<a href=\"regimes.csv\">regimes.csv</a>); baselines and models outside their "
+         "declared validity in a regime's views are left out</caption>\n"
+         "<tr><th>regime</th><th>views</th><th>best (ties: =)</th><th>mean FLIP</th>"
+         "<th>per frame, "
+      << size << ", " << HtmlEscape(CostMachine(config, r))
+      << "</th><th>precompute</th><th>reference noise</th><th>left out</th></tr>\n";
+    for (const RegimeVerdict& v : verdicts) {
+        std::string views, best, flip, frame, pre;
+        for (const std::string& x : v.views) views += (views.empty() ? "" : ", ") + x;
+        for (size_t k = 0; k < v.best.size(); ++k) {
+            const std::string sep = k == 0 ? "" : v.best.size() > 1 ? " = " : ", ";
+            best += sep + r.models[static_cast<size_t>(v.best[k])];
+            flip += (k ? " / " : "") + Fixed(v.flip[k], 4);
+            frame += (k ? " / " : "") + Duration(v.frame_seconds[k]);
+            pre += (k ? " / " : "") + (v.precompute_seconds[k] > 0.0
+                                           ? Duration(v.precompute_seconds[k])
+                                           : std::string("-"));
+        }
+        std::string excluded;
+        for (const std::string& x : v.excluded) excluded += (excluded.empty() ? "" : "; ") + x;
+        f << "<tr><th>" << HtmlEscape(v.kind + ": " + v.regime) << "</th><td style=\"text-align:"
+          << "left;white-space:normal\">" << HtmlEscape(views) << "</td><td class=\""
+          << (v.best.size() > 1 ? "tie" : "best") << "\" style=\"text-align:left\">"
+          << HtmlEscape(best.empty() ? std::string("(none eligible)") : best) << "</td><td>" << flip
+          << "</td><td>" << frame << "</td><td>" << pre << "</td><td>"
+          << (v.reference_noise >= 0.0 ? Fixed(v.reference_noise, 4) : std::string("&ndash;"))
+          << "</td><td style=\"text-align:left;white-space:normal\">" << HtmlEscape(excluded)
+          << "</td></tr>\n";
+    }
+    f << "</table>\n";
+}
+
+// FLIP over the sky and over the ground per view and model (flip_sky.csv,
+// flip_ground.csv), the reference's noise per region beside.
+void RegionTable(std::ostream& f, const CompareResult& r) {
+    f << "<table class=\"metric\" id=\"regions\"><caption>FLIP over the sky / over the ground "
+         "(<a href=\"flip_sky.csv\">flip_sky.csv</a>, <a href=\"flip_ground.csv\">"
+         "flip_ground.csv</a>; RMSE in <a href=\"rmse_sky.csv\">rmse_sky.csv</a>, <a "
+         "href=\"rmse_ground.csv\">rmse_ground.csv</a>; the reference's noise and mean per "
+         "region in <a href=\"reference_noise_regions.csv\">reference_noise_regions.csv</a>)"
+         "</caption>\n<tr><th>view</th>";
+    for (size_t m = 0; m < r.models.size(); ++m) f << "<th>" << HtmlEscape(r.models[m]) << "</th>";
+    f << "<th title=\"ground pixels of the view\">ground share</th><th title=\"the reference's "
+         "twice RMS standard error over the sky / the ground, relative to its mean there\">"
+         "reference relative noise</th></tr>\n";
+    auto value = [](double v) { return std::isfinite(v) ? Fixed(v, 3) : std::string("&ndash;"); };
+    for (const CompareRow& row : r.rows) {
+        f << "<tr><th>" << HtmlEscape(row.label) << "</th>";
+        for (const CompareCell& c : row.cells) {
+            f << "<td>" << value(c.flip_sky) << " / " << value(c.flip_ground) << "</td>";
+        }
+        const double total = static_cast<double>(row.sky_pixels + row.ground_pixels);
+        auto relative = [](double noise, double mean) {
+            return noise >= 0.0 && mean > 0.0 && std::isfinite(mean)
+                       ? General(100.0 * noise / mean, 2) + "%"
+                       : std::string("&ndash;");
+        };
+        f << "<td>" << (total > 0.0 ? Fixed(100.0 * row.ground_pixels / total, 0) + "%" : "")
+          << "</td><td>" << relative(row.reference_rmse_noise_sky, row.reference_mean_sky) << " / "
+          << relative(row.reference_rmse_noise_ground, row.reference_mean_ground) << "</td></tr>\n";
+    }
+    f << "</table>\n";
 }
 
 // The colour bars of a view's FLIP maps and error images.
@@ -365,8 +446,17 @@ void ColourBars(std::ostream& f, const CompareConfig& config, float exposure) {
 }
 
 // Luminance along one line: the reference with its +-2 sigma band, every model.
-void ProfilePlot(std::ostream& f, const CompareRow& row, const CompareRow::Profile& p,
-                 const CompareResult& r) {
+void ProfilePlot(std::ostream& f, const CompareRow& row, const CompareRow::Profile& profile,
+                 const CompareResult& r, bool luminance) {
+    // --luminance: in cd m^-2 (the row's scale).
+    CompareRow::Profile p = profile;
+    if (luminance) {
+        for (double& v : p.reference) v *= row.luminance_scale;
+        for (double& v : p.reference_sigma) v *= row.luminance_scale;
+        for (auto& m : p.models) {
+            for (double& v : m) v *= row.luminance_scale;
+        }
+    }
     const double left = 62, right = 430, top = 26, bottom = 210;
     // The scale follows the reference: from its smallest positive value (at
     // least 1/1000 of its largest) to the largest value of any line, at most
@@ -398,7 +488,7 @@ void ProfilePlot(std::ostream& f, const CompareRow& row, const CompareRow::Profi
     SvgAxes(f, xa, y,
             p.line.vertical ? "angle above the image centre (deg)"
                             : "angle right of the image centre (deg)",
-            "luminance (log)");
+            luminance ? "luminance (cd m^-2, log)" : "luminance (log)");
     auto point = [&](size_t i, double v) {
         return Fixed(xa.Map(a[i]), 1) + "," + Fixed(y.Map(std::max(v, y.lo)), 1);
     };
@@ -507,6 +597,7 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
          "  window.atmosErrors.push(Array.prototype.join.call(arguments, ' '));\n"
          "  return original.apply(console, arguments); }; })();\n</script>\n"
       << "</head><body>\n<h1>" << HtmlEscape(title) << "</h1>\n<p id=\"image-check\"></p>\n";
+    RegimeTable(f, config, r);
 
     // Which model? The summary and accuracy against cost.
     const std::vector<CompareSummary> summary = SummarizeCompare(config, r);
@@ -566,6 +657,32 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
         item("options of " + m, opts.empty() ? "(none)" : opts);
     }
     item("views", std::to_string(r.rows.size()));
+    if (r.reference_noise_target > 0.0) {
+        // Which views' reference reached the noise target (issue 33 item 3).
+        std::string reached, missed;
+        for (const CompareRow& row : r.rows) {
+            const bool ok =
+                row.reference_noise >= 0.0 && row.reference_noise <= r.reference_noise_target;
+            std::string& list = ok ? reached : missed;
+            list += (list.empty() ? "" : ", ") + row.label +
+                    (ok ? ""
+                        : " (" + Fixed(row.reference_noise, 4) + " at " +
+                              std::to_string(row.reference_spp) + " spp)");
+        }
+        const size_t n_reached =
+            reached.empty()
+                ? 0
+                : static_cast<size_t>(std::count(reached.begin(), reached.end(), ',')) + 1;
+        item("reference noise target",
+             General(r.reference_noise_target, 3) + ": reached in " + std::to_string(n_reached) +
+                 " of " + std::to_string(r.rows.size()) + " views" +
+                 (reached.empty() ? "" : " (" + reached + ")") +
+                 (missed.empty()
+                      ? ""
+                      : "; not reached (cap " + std::to_string(config.reference_monte_carlo.spp) +
+                            " paths per pixel): " + missed));
+    }
+    if (config.luminance) item("luminance", config.luminance_note);
     item("command", config.command_line);
     item("CPU", CpuName());
     item("threads", std::to_string(r.threads));
@@ -606,6 +723,24 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
                 transmittance ? "FLIP errors, transmittance (LDR-FLIP)" : "FLIP errors (HDR-FLIP)",
                 6, r, true);
     MetricTable(f, transmittance ? "RMSE errors, transmittance" : "RMSE errors", 8, r, false);
+    RegionTable(f, r);
+    if (config.luminance) {
+        f << "<table class=\"metric\" id=\"luminance\"><caption>Mean luminance over each image, "
+             "cd m^-2 (<a href=\"luminance.csv\">luminance.csv</a>: also over the sky and the "
+             "ground; "
+          << HtmlEscape(config.luminance_note)
+          << ")</caption>\n<tr><th>view</th><th>reference</th>";
+        for (const std::string& m : r.models) f << "<th>" << HtmlEscape(m) << "</th>";
+        f << "</tr>\n";
+        for (const CompareRow& row : r.rows) {
+            f << "<tr><th>" << HtmlEscape(row.label) << "</th><td>"
+              << General(row.reference_luminance.all, 4) << "</td>";
+            for (const CompareCell& c : row.cells)
+                f << "<td>" << General(c.luminance.all, 4) << "</td>";
+            f << "</tr>\n";
+        }
+        f << "</table>\n";
+    }
 
     f << "<h2>Render times</h2>\n";
     TimeChart(f, config, r);
@@ -640,8 +775,7 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
     for (const CompareRow& row : r.rows) {
         f << "<h3 id=\"view-" << HtmlEscape(row.view) << "\">" << HtmlEscape(row.label)
           << "</h3><p>" << HtmlEscape(row.description) << "</p>\n";
-        const float exposure = transmittance ? 1.0f : GetView(row.view, config.atmosphere).exposure;
-        ColourBars(f, config, exposure);
+        ColourBars(f, config, row.exposure);
         f << "<div class=\"row\">\n<figure><img src=\"" << HtmlEscape(row.reference_png)
           << "\" alt=\"reference\" title=\"reference, " << HtmlEscape(row.label)
           << "\"><figcaption><b>reference</b> (" << HtmlEscape(config.reference_model) << ")<br>"
@@ -673,7 +807,9 @@ void WriteCompareReport(const std::string& path, const CompareConfig& config,
         f << "</div>\n";
         if (!row.profiles.empty()) {
             f << "<div class=\"plots\">\n";
-            for (const CompareRow::Profile& p : row.profiles) ProfilePlot(f, row, p, r);
+            for (const CompareRow::Profile& p : row.profiles) {
+                ProfilePlot(f, row, p, r, config.luminance);
+            }
             f << "</div>\n";
         }
     }
@@ -747,9 +883,19 @@ std::vector<CompareSummary> SummarizeCompare(const CompareConfig& config, const 
         out.push_back(s);
     }
     std::vector<double> means, times;
-    for (const CompareSummary& s : out) {
+    for (size_t m = 0; m < out.size(); ++m) {
+        CompareSummary& s = out[m];
+        bool baseline = false;
+        try {
+            baseline = GetModelInfo(r.model_names[m]).capabilities.baseline;
+        } catch (const Error&) {
+        }
+        s.pareto_apart = baseline              ? "a baseline"
+                         : !s.validity.empty() ? "outside its declared validity in some views"
+                                               : "";
         means.push_back(s.mean_flip);
-        times.push_back(s.frame_seconds > 0.0 ? s.frame_seconds : std::nan(""));
+        times.push_back(s.frame_seconds > 0.0 && s.pareto_apart.empty() ? s.frame_seconds
+                                                                        : std::nan(""));
     }
     const std::vector<int> ranks = TiedRanks(means, MeanReferenceNoise(r));
     for (size_t m = 0; m < out.size(); ++m) out[m].rank = ranks[m];

@@ -41,8 +41,12 @@ struct CompareSummary {
     int64_t table_bytes = -1;          // CompareResult::table_bytes
     int lines = -1;                    // significant lines of code of its model
     int rank = 0;                      // TiedRanks of mean_flip, noise = MeanReferenceNoise
-    bool pareto = false;               // on the Pareto front of (frame_seconds, mean_flip)
-    std::string validity;              // the views outside its declared validity
+    // On the Pareto front of (frame_seconds, mean_flip) among the eligible
+    // models: not a baseline (ModelCapabilities::baseline) and inside its
+    // declared validity in every view; pareto_apart says why one is not eligible.
+    bool pareto = false;
+    std::string pareto_apart;
+    std::string validity;  // the views outside its declared validity
 };
 
 // The mean over the views of the reference's noise (HDR-FLIP between its

@@ -46,6 +46,7 @@ ModelInfo EmptyModel::StaticInfo() {
     info.title = "Empty (constant white)";
     info.citation = "Leenman's 2025 thesis section 11.2.1";
     info.summary = "no physics: the overhead baseline of the render loop";
+    info.capabilities.baseline = true;
     return info;
 }
 

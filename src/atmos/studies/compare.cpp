@@ -1,6 +1,7 @@
 // atmos studies: the compare study's defaults and policy (compare.h).
 #include "studies/compare.h"
 
+#include <cstdio>
 #include <filesystem>
 #include <string>
 
@@ -8,6 +9,7 @@
 #include "atmos/spectral.h"
 #include "harness/loc.h"
 #include "render/progressive.h"
+#include "studies/compare_views.h"
 
 namespace atmos {
 
@@ -17,11 +19,39 @@ CompareConfig ResolveCompareConfig(const CompareRequest& q) {
     config.height = q.height;
     config.quantity = ParseQuantity(q.quantity);
     config.models = q.models;
-    config.views = q.views;
-    for (const std::string& v : q.views) GetView(v, AtmosphereParameters{});  // fail early
-    for (const std::string& m : q.models) ParseModelSpec(m);                  // fail early
+    for (const std::string& m : q.models) ParseModelSpec(m);  // fail early
     config.atmosphere_name = q.atmosphere;
     config.atmosphere = LoadAtmosphere(q.atmosphere, q.sets);
+    // Views: names of the 12, and the entries of views files in order.
+    for (const std::string& v : q.views) {
+        if (!IsCompareViewsFile(v)) {
+            GetView(v, AtmosphereParameters{});  // fail early
+            config.views.push_back(v);
+            continue;
+        }
+        if (ParseQuantity(q.quantity) != Quantity::kRadiance) {
+            Fail("--views ", v, ": custom views compare radiance (not --quantity ", q.quantity,
+                 ")");
+        }
+        for (const CompareViewEntry& e : ReadCompareViews(v, q.width, q.height)) {
+            config.custom_views.push_back(MakeCompareView(e, config.atmosphere));
+            config.views.push_back(e.name);
+        }
+    }
+    if (!q.views_json.empty()) {
+        for (const CompareViewEntry& e :
+             ParseCompareViews(q.views_json, "views", q.width, q.height)) {
+            config.custom_views.push_back(MakeCompareView(e, config.atmosphere));
+            config.views.push_back(e.name);
+        }
+    }
+    for (size_t i = 0; i < config.views.size(); ++i) {
+        for (size_t j = 0; j < i; ++j) {
+            if (config.views[i] == config.views[j]) {
+                Fail("--views: view '", config.views[i], "' is given twice");
+            }
+        }
+    }
     if (!q.wavelengths.empty()) {
         // Spectral: every model and the reference at the wavelengths, as linear sRGB
         // (harness/spectral_run.h); the render cache is not used.
@@ -62,6 +92,36 @@ CompareConfig ResolveCompareConfig(const CompareRequest& q) {
     config.flip.exposure_setup = ParseFlipExposureSetup(q.exposure);
     config.command_line = q.command_line;
     config.batching = q.batching;
+    config.machine = q.cuda ? "CUDA GPU" : "CPU";
+    if (q.luminance) {
+        if (config.quantity != Quantity::kRadiance) Fail("--luminance applies to radiance");
+        if (!q.reference_wavelengths.empty()) {
+            Fail(
+                "--luminance: not with --reference-wavelengths (the reference's and the "
+                "models' images are in different units there)");
+        }
+        config.luminance = true;
+        if (HasPhysicalSolarSpectrum(LoadSpectralAtmosphere(q.atmosphere, q.sets))) {
+            config.luminance_scale = kMaxLuminousEfficacy * CieYIntegral();
+            config.luminance_note =
+                std::string("cd m^-2: Y of the images (") +
+                (q.wavelengths.empty() ? "Rec. 709 Y of RGB radiance at 680, 550, 440 nm"
+                                       : "CIE 1931 Y of the spectral images") +
+                ", W m^-2 sr^-1 nm^-1 with the atmosphere's tabulated solar spectrum in W m^-2 "
+                "nm^-1) x 683 lm/W x 106.86 nm, per unit of the view's sun multiplier";
+        } else {
+            config.luminance_scale = SolarIlluminanceLux();
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%.6g", config.luminance_scale);
+            config.luminance_note =
+                std::string(
+                    "cd m^-2: Rec. 709 Y of the RGB images (radiance per unit solar "
+                    "irradiance) x the Sun's illuminance at 1 AU, ") +
+                buf +
+                " lx (ASTM G173 extraterrestrial spectrum), per unit of the view's sun "
+                "multiplier";
+        }
+    }
 
     // The reference: CompareConfig's default (the path tracer) unless one is named.
     if (q.reference) {
@@ -133,6 +193,21 @@ CompareConfig ResolveCompareConfig(const CompareRequest& q) {
                                  "rgb_cost.csv compares each model with the RGB reference too";
     }
     return config;
+}
+
+bool HasPhysicalSolarSpectrum(const SpectralAtmosphere& atmosphere) {
+    if (!atmosphere.spectral) return false;  // an RGB file: per unit solar irradiance
+    for (const SpectralTerm& t : atmosphere.solar_irradiance.terms) {
+        if (t.kind == SpectralTerm::Kind::kTable) return true;
+    }
+    return false;
+}
+
+double SolarIlluminanceLux() {
+    std::vector<double> nm, e;
+    SpectralDataTable("astm-g173-etr-10nm", 0, &nm, &e);
+    const Vec3d xyz = SpectrumToXyz(nm, WavelengthWeights(nm), e.data());
+    return kMaxLuminousEfficacy * xyz.y;
 }
 
 }  // namespace atmos
