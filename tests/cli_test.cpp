@@ -27,48 +27,23 @@
 #include "atmos/model.h"
 #include "base/parallel.h"
 #include "io/image_formats.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path TempDir() {
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
-    dir /= "cli";
-    fs::create_directories(dir);
-    return dir;
-}
+using atmos_test::Slurp;
+using Result = atmos_test::CommandOutcome;
 
-struct Result {
-    int status = -1;
-    std::string out;
-    std::string err;
-};
-
-std::string Slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
+fs::path TempDir() { return atmos_test::TestTmpDir("cli"); }
 
 // Runs `atmos ARGS` (stdin from `input` if not empty), capturing both streams.
 Result RunAtmos(const std::string& args, const std::string& input = "") {
     static int counter = 0;
-    const fs::path dir = TempDir();
     // Unique per process: ctest runs each test in its own process, in parallel.
     const std::string id = std::to_string(getpid()) + "_" + std::to_string(++counter);
-    const fs::path out = dir / ("out" + id), err = dir / ("err" + id), in = dir / ("in" + id);
-    std::ofstream(in) << input;
-    const std::string cmd = std::string(ATMOS_CLI_PATH) + " " + args + " < " + in.string() + " > " +
-                            out.string() + " 2> " + err.string();
-    const int raw = std::system(cmd.c_str());
-    Result r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = Slurp(out);
-    r.err = Slurp(err);
-    return r;
+    return atmos_test::RunAtmosWithInput(TempDir(), id, args, input);
 }
 
 // An error: non-zero exit and exactly one line on stderr, mentioning `needle`.
@@ -501,48 +476,13 @@ TEST(Cli, SigintCheckpointsAndStops) {
         ATMOS_CLI_PATH, "render",     "--model", "reference", "--view",
         "plane-dawn",   "--size",     "8x4",     "-q",        "--spp",
         "200000",       "--pass-spp", "1",       "-o",        (dir / "i.exr").string()};
-    std::vector<char*> argv;
-    for (std::string& w : argv_text) argv.push_back(w.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t files;
-    posix_spawn_file_actions_init(&files);
-    posix_spawn_file_actions_addopen(&files, 1, "/dev/null", O_WRONLY, 0);
-    const std::string err_path = (dir / "err").string();
-    posix_spawn_file_actions_addopen(&files, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                     0644);
-    posix_spawnattr_t attr;
-    posix_spawnattr_init(&attr);
-    sigset_t none, stops;
-    sigemptyset(&none);
-    sigemptyset(&stops);
-    sigaddset(&stops, SIGINT);
-    sigaddset(&stops, SIGTERM);
-    posix_spawnattr_setsigmask(&attr, &none);
-    posix_spawnattr_setsigdefault(&attr, &stops);
-    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
     pid_t pid = 0;
-    const int spawned = posix_spawn(&pid, ATMOS_CLI_PATH, &files, &attr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&files);
-    posix_spawnattr_destroy(&attr);
+    const int spawned = atmos_test::SpawnWithDefaultSignals(argv_text, (dir / "err").string(),
+                                                            {SIGINT, SIGTERM}, &pid);
     ASSERT_EQ(spawned, 0) << std::strerror(spawned);
-    // Wait (no time limit: ctest's own bounds it) until the render catches
-    // SIGINT or has ended.
-    const std::string status_path = "/proc/" + std::to_string(pid) + "/status";
-    bool catching = false;
+    // Wait until the render catches SIGINT or has ended.
     int raw = 0;
-    bool ended = false;
-    while (!catching && !ended) {
-        std::ifstream status(status_path);
-        for (std::string line; std::getline(status, line);) {
-            if (line.rfind("SigCgt:", 0) == 0) {
-                catching = (std::stoull(line.substr(7), nullptr, 16) >> (SIGINT - 1)) & 1u;
-            }
-        }
-        if (!catching) {
-            ended = waitpid(pid, &raw, WNOHANG) == pid;
-            if (!ended) usleep(5000);
-        }
-    }
+    const bool ended = atmos_test::WaitUntilCatching(pid, SIGINT, 5000, &raw);
     ASSERT_FALSE(ended) << "the render ended before it caught SIGINT: " << Slurp(dir / "err");
     ASSERT_EQ(kill(pid, SIGINT), 0);
     ASSERT_EQ(waitpid(pid, &raw, 0), pid);

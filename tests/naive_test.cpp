@@ -14,6 +14,7 @@
 #include "base/parallel.h"
 #include "models/naive.h"
 #include "physics/transmittance.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -245,17 +246,7 @@ TEST(Render, SameBytesForOneAndTwoThreads) {
     request.width = 97;  // not a multiple of the tile size
     request.height = 41;
     request.show_progress = false;
-    Image one, two;
-    {
-        ThreadLimit limit(1);
-        model->Render(request, &one);
-    }
-    {
-        ThreadLimit limit(2);
-        model->Render(request, &two);
-    }
-    ASSERT_EQ(one.size(), two.size());
-    EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
+    atmos_test::ExpectSameImageForOneAndTwoThreads(*model, request);
 }
 
 TEST(Sample, MatchesEvaluatorAndContract) {

@@ -22,6 +22,7 @@
 #include "base/rng.h"
 #include "metrics/flip.h"
 #include "render/progressive.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -95,14 +96,26 @@ RenderRequest CoinRequest(int64_t spp, int64_t pass_spp) {
     return r;
 }
 
-std::filesystem::path TestDir(const char* name) {
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    const std::filesystem::path dir =
-        (env ? std::filesystem::path(env) : std::filesystem::temp_directory_path() / "atmos_test") /
-        name;
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    return dir;
+std::filesystem::path TestDir(const char* name) { return atmos_test::FreshTestTmpDir(name); }
+
+// Renders `request` with a checkpoint in the fresh folder `dir_name` and
+// returns the checkpoint file's path (request->checkpoint set).
+std::string WriteCoinCheckpoint(const CoinModel& model, const char* dir_name,
+                                RenderRequest* request, Image* image) {
+    request->checkpoint = (TestDir(dir_name) / "coin").string();
+    model.Render(*request, image);
+    return request->checkpoint + ".bin";
+}
+
+// A checkpoint's bytes with the trailing FNV-1a checksum recomputed (after an edit).
+std::string ResumCheckpoint(std::string bytes) {
+    uint64_t h = 14695981039346656037ull;
+    for (size_t i = 0; i + 8 < bytes.size(); ++i) {
+        h ^= static_cast<unsigned char>(bytes[i]);
+        h *= 1099511628211ull;
+    }
+    std::memcpy(&bytes[bytes.size() - 8], &h, 8);
+    return bytes;
 }
 
 TEST(Progressive, PassesOfAnyMonteCarloModelWeightedByTheirCounts) {
@@ -238,30 +251,13 @@ TEST(Progressive, SettingsAreValidatedWithOneClearError) {
 // error, never a wrong image.
 TEST(Progressive, ADamagedCheckpointIsOneClearError) {
     const CoinModel model(true);
-    const std::filesystem::path dir = TestDir("progressive_damaged");
     RenderRequest request = CoinRequest(6, 3);
-    request.checkpoint = (dir / "coin").string();
     Image image;
-    model.Render(request, &image);
-    const std::string path = request.checkpoint + ".bin";
-    std::string good;
-    {
-        std::ifstream f(path, std::ios::binary);
-        good.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-    }
+    const std::string path = WriteCoinCheckpoint(model, "progressive_damaged", &request, &image);
+    const std::string good = atmos_test::Slurp(path);
     ASSERT_GT(good.size(), 16u + 2 * 5 * 3 * 3 * sizeof(float));
     auto write = [&](const std::string& bytes) {
         std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
-    };
-    // Recomputes the trailing FNV-1a checksum after an edit.
-    auto resum = [](std::string bytes) {
-        uint64_t h = 14695981039346656037ull;
-        for (size_t i = 0; i + 8 < bytes.size(); ++i) {
-            h ^= static_cast<unsigned char>(bytes[i]);
-            h *= 1099511628211ull;
-        }
-        std::memcpy(&bytes[bytes.size() - 8], &h, 8);
-        return bytes;
     };
     request.monte_carlo.spp = 12;
     request.resume = true;
@@ -284,14 +280,14 @@ TEST(Progressive, ADamagedCheckpointIsOneClearError) {
     ASSERT_NE(at, std::string::npos);
     std::string counts = good;
     counts[at + 15] = '2';  // 2 samples in 2 passes of 3
-    expect_damaged(resum(counts), "counts disagree");
+    expect_damaged(ResumCheckpoint(counts), "counts disagree");
     std::string nan = good;
     const float q = std::numeric_limits<float>::quiet_NaN();
     std::memcpy(&nan[good.size() - 8 - 4], &q, 4);
-    expect_damaged(resum(nan), "not finite");
+    expect_damaged(ResumCheckpoint(nan), "not finite");
     std::string longer = good;
     longer.insert(good.size() - 8, 4, '\0');
-    expect_damaged(resum(longer), "wrong size");
+    expect_damaged(ResumCheckpoint(longer), "wrong size");
     // The intact checkpoint resumes to the uninterrupted image.
     write(good);
     Image resumed, full;
@@ -309,33 +305,17 @@ TEST(Progressive, ADamagedCheckpointIsOneClearError) {
 // a FIFO in its place is one clear error, never a block.
 TEST(Progressive, ACheckpointsSumsAreRangeChecked) {
     const CoinModel model(true);
-    const std::filesystem::path dir = TestDir("progressive_ranges");
     RenderRequest request = CoinRequest(6, 3);
-    request.checkpoint = (dir / "coin").string();
     Image image;
-    model.Render(request, &image);
-    const std::string path = request.checkpoint + ".bin";
-    std::string good;
-    {
-        std::ifstream f(path, std::ios::binary);
-        good.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-    }
+    const std::string path = WriteCoinCheckpoint(model, "progressive_ranges", &request, &image);
+    const std::string good = atmos_test::Slurp(path);
     uint64_t header_size = 0;
     std::memcpy(&header_size, good.data() + 8, 8);
     const size_t sums = 16 + header_size, n = 5 * 3 * 3;
-    auto resum = [](std::string bytes) {
-        uint64_t h = 14695981039346656037ull;
-        for (size_t i = 0; i + 8 < bytes.size(); ++i) {
-            h ^= static_cast<unsigned char>(bytes[i]);
-            h *= 1099511628211ull;
-        }
-        std::memcpy(&bytes[bytes.size() - 8], &h, 8);
-        return bytes;
-    };
     auto with_float = [&](size_t index, float value) {
         std::string bytes = good;
         std::memcpy(&bytes[sums + 4 * index], &value, 4);
-        return resum(bytes);
+        return ResumCheckpoint(bytes);
     };
     request.monte_carlo.spp = 12;
     request.resume = true;
@@ -364,7 +344,7 @@ TEST(Progressive, ACheckpointsSumsAreRangeChecked) {
     const size_t at = seed.find("\"seed\":11");
     ASSERT_NE(at, std::string::npos);
     seed[at + 8] = '2';
-    expect_refused(resum(seed), "different render");
+    expect_refused(ResumCheckpoint(seed), "different render");
     EXPECT_NE(good.find("\"estimator_version\""), std::string::npos);
     // A directory, a FIFO: one clear error at once.
     std::filesystem::remove(path);

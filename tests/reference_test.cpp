@@ -24,6 +24,7 @@
 #include "models/reference.h"
 #include "physics/transmittance.h"
 #include "render/render.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -397,26 +398,11 @@ TEST(ReferenceDeterminism, SameImageForAnyThreadCountAndAfterResume) {
     request.width = 24;
     request.height = 13;
     request.show_progress = false;
-    Image one, two;
-    {
-        ThreadLimit limit(1);
-        model->Render(request, &one);
-    }
-    {
-        ThreadLimit limit(2);
-        model->Render(request, &two);
-    }
-    ASSERT_EQ(one.size(), two.size());
-    EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
+    const Image one = atmos_test::ExpectSameImageForOneAndTwoThreads(*model, request);
 
     // Interrupted after 4 of 8 spp (a render with --spp 4 and the same pass
     // size writes the checkpoint), then resumed to 8: identical to the full run.
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    const std::filesystem::path dir =
-        (env ? std::filesystem::path(env) : std::filesystem::temp_directory_path() / "atmos_test") /
-        "reference_resume";
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
+    const std::filesystem::path dir = atmos_test::FreshTestTmpDir("reference_resume");
     RenderRequest checkpointed = request;
     checkpointed.checkpoint = (dir / "ckpt").string();
     checkpointed.monte_carlo.spp = 4;

@@ -17,6 +17,17 @@
 
 namespace atmos {
 
+int RunShellCommand(const std::string& command, std::string* output) {
+    output->clear();
+    std::FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+    if (!pipe) return -1;
+    char buffer[4096];
+    size_t n;
+    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) output->append(buffer, n);
+    const int status = pclose(pipe);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
 namespace engine_shaders {
 
 namespace fs = std::filesystem;
@@ -176,21 +187,9 @@ std::string Quote(const fs::path& p) {
     return s + "'";
 }
 
-// Runs a shell command; returns its exit status and puts stdout+stderr in *output.
-int Run(const std::string& command, std::string* output) {
-    output->clear();
-    std::FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-    if (!pipe) return -1;
-    char buffer[4096];
-    size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) output->append(buffer, n);
-    const int status = pclose(pipe);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 bool ToolFound(const char* tool) {
     std::string out;
-    return Run(std::string("command -v ") + tool, &out) == 0;
+    return RunShellCommand(std::string("command -v ") + tool, &out) == 0;
 }
 
 std::string FirstLines(const std::string& text) {
@@ -307,18 +306,19 @@ void WriteEngineShaders(const std::string& dir_text, const std::string& model_na
         stem[stem.rfind('.')] = '_';
         const fs::path spv = spirv / (stem + ".spv");
         std::string out;
-        if (Run("glslangValidator -V --target-env vulkan1.0 -S " + s.stage + " -o " + Quote(spv) +
-                    " " + Quote(vulkan / s.name),
-                &out) != 0) {
+        if (RunShellCommand("glslangValidator -V --target-env vulkan1.0 -S " + s.stage + " -o " +
+                                Quote(spv) + " " + Quote(vulkan / s.name),
+                            &out) != 0) {
             Fail("bake: glslangValidator -V refused ", (vulkan / s.name).string(), ": ",
                  FirstLines(out));
         }
-        if (Run("spirv-cross " + Quote(spv) + " --hlsl --shader-model 50 --output " +
-                    Quote(hlsl / (stem + ".hlsl")),
-                &out) != 0) {
+        if (RunShellCommand("spirv-cross " + Quote(spv) + " --hlsl --shader-model 50 --output " +
+                                Quote(hlsl / (stem + ".hlsl")),
+                            &out) != 0) {
             Fail("bake: spirv-cross --hlsl failed on ", spv.string(), ": ", FirstLines(out));
         }
-        if (Run("spirv-cross " + Quote(spv) + " --msl --output " + Quote(msl / (stem + ".metal")),
+        if (RunShellCommand(
+                "spirv-cross " + Quote(spv) + " --msl --output " + Quote(msl / (stem + ".metal")),
                 &out) != 0) {
             Fail("bake: spirv-cross --msl failed on ", spv.string(), ": ", FirstLines(out));
         }
