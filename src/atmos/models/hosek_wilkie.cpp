@@ -201,7 +201,7 @@ void HosekWilkieModel::Prepare(const AtmosphereParameters& atmosphere) {
     HosekWilkieEvaluator& e = evaluator_;
     e.bottom = atmosphere.bottom_radius;
     e.top = atmosphere.top_radius;
-    e.has_view = false;
+    e.view.has_view = false;
     for (auto& row : e.mix) {
         for (double& m : row) m = 0.0;
     }
