@@ -14,6 +14,7 @@
 
 #include "atmos/error.h"
 #include "io/output_path.h"
+#include "io/text_files.h"
 
 namespace atmos {
 
@@ -31,14 +32,6 @@ int RunShellCommand(const std::string& command, std::string* output) {
 namespace engine_shaders {
 
 namespace fs = std::filesystem;
-
-std::string ReadText(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) Fail("cannot read '", path.string(), "'");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 // The frame's uniform block (std140, set 0, binding 0), shared by every stage.
 // hillaire's aerial-perspective camera (the WebGL2 source's loose atmos_ap_*
@@ -215,9 +208,9 @@ void WriteEngineShaders(const std::string& dir_text, const std::string& model_na
         if (c == '-') c = '_';
     }
     const fs::path shaders = dir / "shaders";
-    const std::string constants = ReadText(shaders / (file + "_constants.glsl"));
-    const std::string common = ReadText(shaders / "common.glsl");
-    const std::string model = ReadText(shaders / (file + ".glsl"));
+    const std::string constants = ReadWholeFile(shaders / (file + "_constants.glsl"));
+    const std::string common = ReadWholeFile(shaders / "common.glsl");
+    const std::string model = ReadWholeFile(shaders / (file + ".glsl"));
 
     std::vector<Binding> bindings = {{0, "AtmosFrame", "uniform block (std140)"}};
     int next_binding = 1;
