@@ -46,6 +46,8 @@ Result RunAtmos(const std::string& args, const std::string& input = "") {
     return atmos_test::RunAtmosWithInput(TempDir(), id, args, input);
 }
 
+bool HaveStrace() { return std::system("strace -o /dev/null true > /dev/null 2>&1") == 0; }
+
 // An error: non-zero exit and exactly one line on stderr, mentioning `needle`.
 void ExpectError(const std::string& args, const std::string& needle,
                  const std::string& input = "") {
@@ -402,12 +404,8 @@ TEST(Cli, MonteCarloFlags) {
 // render of 4 spp is checkpointed, extending it to 8 is killed at the k-th such
 // call, and the resumed render is the uninterrupted one.
 TEST(Cli, CheckpointSurvivesAKillAtEveryWriteAndRename) {
-    if (std::system("strace -o /dev/null true > /dev/null 2>&1") != 0) {
-        GTEST_SKIP() << "strace is not available";
-    }
-    const fs::path dir = TempDir() / "kill";
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    if (!HaveStrace()) GTEST_SKIP() << "strace is not available";
+    const fs::path dir = atmos_test::FreshTestTmpDir("cli/kill");
     const std::string base =
         "render --model reference --view plane-dawn --size 24x12 -q --seed 3 "
         "--pass-spp 2 --checkpoint " +
@@ -446,9 +444,7 @@ TEST(Cli, CheckpointSurvivesAKillAtEveryWriteAndRename) {
 // Issue 18 item 10: the checkpoint is deleted once the image is written,
 // unless --keep-checkpoint.
 TEST(Cli, CheckpointDeletedAfterSuccessUnlessKept) {
-    const fs::path dir = TempDir() / "ckpt_delete";
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = atmos_test::FreshTestTmpDir("cli/ckpt_delete");
     const std::string base = "render --model reference --view plane-dawn --size 8x4 -q --spp 2 ";
     ASSERT_EQ(RunAtmos(base + "-o " + (dir / "a.exr").string()).status, 0);
     EXPECT_TRUE(fs::exists(dir / "a.exr"));
@@ -461,9 +457,7 @@ TEST(Cli, CheckpointDeletedAfterSuccessUnlessKept) {
 // writes the checkpoint and stops with one line saying how to resume.
 TEST(Cli, SigintCheckpointsAndStops) {
     if (!fs::exists("/proc/self/status")) GTEST_SKIP() << "no /proc";
-    const fs::path dir = TempDir() / "sigint";
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = atmos_test::FreshTestTmpDir("cli/sigint");
     // The render is spawned directly, with SIGINT and SIGTERM at their default
     // action and unblocked, whatever this test inherited: a CI that starts the
     // suite with SIGINT blocked (or ignored, as a shell's background job is)
@@ -501,12 +495,8 @@ TEST(Cli, SigintCheckpointsAndStops) {
 // at the third commit (strace) stops the render inside its first pass with one
 // line, and --resume finishes it to exactly the uninterrupted image.
 TEST(Cli, SigintInsideAPassCheckpointsAndResumesToTheSameImage) {
-    if (std::system("strace -o /dev/null true > /dev/null 2>&1") != 0) {
-        GTEST_SKIP() << "strace is not available";
-    }
-    const fs::path dir = TempDir() / "sigint_band";
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    if (!HaveStrace()) GTEST_SKIP() << "strace is not available";
+    const fs::path dir = atmos_test::FreshTestTmpDir("cli/sigint_band");
     const std::string base =
         "render --model reference --view plane-dawn --size 24x12 -q --seed 5 --spp 4 "
         "--pass-spp 2 --checkpoint-every 0 --checkpoint " +
@@ -772,9 +762,7 @@ TEST(Cli, ValidateKiderOnTwoCaptures) {
 // temporary behind (std::ofstream left a truncated file under the final name).
 TEST(Cli, TextOutputsAreWrittenAtomically) {
     if (std::system("bash -c 'ulimit -f 1' > /dev/null 2>&1") != 0) GTEST_SKIP() << "no bash";
-    const fs::path dir = TempDir() / "atomic_text";
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = atmos_test::FreshTestTmpDir("cli/atomic_text");
     const fs::path data = fs::path(ATMOS_SOURCE_DIR) / "tests" / "data" / "kider-2013";
     // 40 queries for sample's CSV outputs (each over 1 KiB).
     {

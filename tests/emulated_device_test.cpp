@@ -26,6 +26,7 @@
 #include "models/hillaire.h"
 #include "render/render.h"
 #include "render/stages.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -391,11 +392,7 @@ TEST(EmulatedDevice, TablesStayOnTheDeviceFromPrepareToRender) {
         std::unique_ptr<Model> model = CreateModel(name);
         const BackendScope scope(Backend::kEmulatedDevice);
         model->Prepare(atm);
-        RenderRequest request;
-        request.view = GetView("ground-sunrise", atm);
-        request.width = 8;
-        request.height = 4;
-        request.show_progress = false;
+        RenderRequest request = atmos_test::QuietRequest(GetView("ground-sunrise", atm), 8, 4);
         std::vector<StageTime> log;
         const StageLogScope logging(&log);
         Image image;

@@ -241,11 +241,8 @@ TEST(Render, AllTwelveViewsFiniteAndNonNegative) {
 TEST(Render, SameBytesForOneAndTwoThreads) {
     auto model = CreateModel("naive");
     model->Prepare(EarthAtmosphere());
-    RenderRequest request;
-    request.view = GetView("ground-sunrise", EarthAtmosphere());
-    request.width = 97;  // not a multiple of the tile size
-    request.height = 41;
-    request.show_progress = false;
+    RenderRequest request = atmos_test::QuietRequest(GetView("ground-sunrise", EarthAtmosphere()),
+                                                     97, 41);  // not a multiple of the tile size
     atmos_test::ExpectSameImageForOneAndTwoThreads(*model, request);
 }
 

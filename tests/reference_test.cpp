@@ -436,11 +436,7 @@ TEST(Reference, FiniteNonNegativeInEveryView) {
     const AtmosphereParameters atm = LoadAtmosphere("earth-bruneton");  // albedo 0.1: bounces
     model->Prepare(atm);
     for (const View& view : StandardViews(atm)) {
-        RenderRequest request;
-        request.view = view;
-        request.width = 16;
-        request.height = 9;
-        request.show_progress = false;
+        RenderRequest request = atmos_test::QuietRequest(view, 16, 9);
         request.monte_carlo.spp = 2;
         Image image;
         model->Render(request, &image);
@@ -935,11 +931,7 @@ TEST(ReferenceHybrid, Order1CachedPerRequestEqualsTheUncachedEstimate) {
     model->Prepare(atm);
     for (const char* name : {"ground-noon", "ground-dawn", "ground-noon"}) {
         SCOPED_TRACE(name);
-        RenderRequest request;
-        request.view = GetView(name, atm);
-        request.width = 12;
-        request.height = 7;
-        request.show_progress = false;
+        RenderRequest request = atmos_test::QuietRequest(GetView(name, atm), 12, 7);
         request.monte_carlo.spp = 8;
         request.monte_carlo.pass_spp = 4;
         request.monte_carlo.seed = 3;
@@ -1070,11 +1062,7 @@ TEST(ReferenceShipped, FreshRenderAgreesWithEachShippedImageWithinItsNoise) {
         double same = 0.0, other = 0.0;
         for (const AtmosphereParameters* a : {&atm, &changed}) {
             model->Prepare(*a);
-            RenderRequest request;
-            request.view = GetView(name, *a);
-            request.width = width;
-            request.height = height;
-            request.show_progress = false;
+            RenderRequest request = atmos_test::QuietRequest(GetView(name, *a), width, height);
             request.monte_carlo.spp = 64;
             request.monte_carlo.pass_spp = 8;
             request.monte_carlo.seed = 777;

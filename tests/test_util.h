@@ -19,11 +19,14 @@
 #include <initializer_list>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
+#include "atmos/error.h"
 #include "atmos/image.h"
 #include "atmos/model.h"
 #include "base/parallel.h"
+#include "render/stages.h"
 
 extern char** environ;
 
@@ -155,4 +158,43 @@ inline atmos::Image ExpectSameImageForOneAndTwoThreads(const atmos::Model& model
     return one;
 }
 
+// True when every stage is trivially copyable and declared a device stage
+// (ATMOS_DEVICE_STAGE, render/stages.h).
+template <typename... Stages>
+constexpr bool kAreDeviceStages =
+    ((std::is_trivially_copyable<Stages>::value && atmos::HasDeviceStage<Stages>::value) && ...);
+
+// Runs `f`, expects atmos::Error, and returns its message ("" if none was thrown).
+template <typename F>
+std::string ErrorMessage(F f) {
+    try {
+        f();
+    } catch (const atmos::Error& e) {
+        return e.what();
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "threw a non-atmos exception: " << e.what();
+        return "";
+    }
+    ADD_FAILURE() << "did not throw";
+    return "";
+}
+
+// A render request of `view` at width x height, without progress bars.
+inline atmos::RenderRequest QuietRequest(const atmos::View& view, int width, int height) {
+    atmos::RenderRequest request;
+    request.view = view;
+    request.width = width;
+    request.height = height;
+    request.show_progress = false;
+    return request;
+}
+
 }  // namespace atmos_test
+
+// `statement` throws an atmos::Error whose message contains `text`.
+#define EXPECT_ERROR_CONTAINS(statement, text)                                             \
+    do {                                                                                   \
+        const std::string message_ = atmos_test::ErrorMessage([&] { (void)(statement); }); \
+        EXPECT_NE(message_.find(text), std::string::npos)                                  \
+            << "message: \"" << message_ << "\" lacks \"" << (text) << "\"";               \
+    } while (0)
