@@ -1,13 +1,26 @@
 // atmos: what the fitted ground-viewer skies (`preetham`, `hosek-wilkie`)
-// share: the sun raised to the horizon, the sun terms of the view kept by
+// share: their capabilities, the sun raised to the horizon, the sun terms of the view kept by
 // PrepareView (physics/ray.h), and their Evaluate around the sky's formula.
 #pragma once
 
 #include "atmos/math.h"
+#include "atmos/model.h"
 #include "physics/geometry.h"
 #include "physics/ray.h"
 
 namespace atmos {
+
+// The capabilities both share: a ground viewer's sky (no space views, no sun
+// below the horizon), no transmittance, fitted to a full simulation (multiple
+// scattering).
+inline ModelCapabilities FittedSkyCapabilities() {
+    ModelCapabilities c;
+    c.transmittance = false;
+    c.space_views = false;
+    c.sun_below_horizon = false;
+    c.multiple_scattering = true;
+    return c;
+}
 
 // The sun direction, raised to the horizon of `up` when below it; *cos_s is
 // its cosine to `up` (0 when raised).
