@@ -31,14 +31,11 @@ struct ErfcTransmittanceOptics {
 };
 
 class TransmittanceErfcModel
-    : public TransmittanceModel<TransmittanceErfcModel, ErfcTransmittanceOptics> {
+    : public OptionlessTransmittanceModel<TransmittanceErfcModel, ErfcTransmittanceOptics,
+                                          AnalyticMedia, MakeAnalyticMedia> {
   public:
-    static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit TransmittanceErfcModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
     static ModelInfo StaticInfo();
-    ErfcTransmittanceOptics MakeOptics(const AtmosphereParameters& atmosphere) const {
-        return ErfcTransmittanceOptics{MakeAnalyticMedia(atmosphere)};
-    }
 };
 
 }  // namespace atmos

@@ -62,19 +62,19 @@ struct PolynomialTransmittanceOptics {
 };
 
 // Least-squares fit of Eq. 42 to the atmosphere's numerical transmittance
-// (host). `rms_error` (optional) receives the fit's RMS error in T.
-PolynomialSigmoid FitPolynomialSigmoid(const AtmosphereParameters& atmosphere,
-                                       double* rms_error = nullptr);
+// (host). `rms_error` receives the fit's RMS error in T.
+PolynomialSigmoid FitPolynomialSigmoid(const AtmosphereParameters& atmosphere, double* rms_error);
+inline PolynomialSigmoid FitPolynomialSigmoid(const AtmosphereParameters& atmosphere) {
+    return FitPolynomialSigmoid(atmosphere, nullptr);
+}
 
 class TransmittancePolynomialModel
-    : public TransmittanceModel<TransmittancePolynomialModel, PolynomialTransmittanceOptics> {
+    : public OptionlessTransmittanceModel<TransmittancePolynomialModel,
+                                          PolynomialTransmittanceOptics, PolynomialSigmoid,
+                                          FitPolynomialSigmoid> {
   public:
-    static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit TransmittancePolynomialModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
     static ModelInfo StaticInfo();
-    PolynomialTransmittanceOptics MakeOptics(const AtmosphereParameters& atmosphere) const {
-        return PolynomialTransmittanceOptics{FitPolynomialSigmoid(atmosphere)};
-    }
 };
 
 }  // namespace atmos
