@@ -18,6 +18,7 @@
 #include "atmos/atmosphere.h"
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "base/fnv1a.h"
 #include "base/progress.h"
 #include "base/rng.h"
 #include "metrics/flip.h"
@@ -109,11 +110,7 @@ std::string WriteCoinCheckpoint(const CoinModel& model, const char* dir_name,
 
 // A checkpoint's bytes with the trailing FNV-1a checksum recomputed (after an edit).
 std::string ResumCheckpoint(std::string bytes) {
-    uint64_t h = 14695981039346656037ull;
-    for (size_t i = 0; i + 8 < bytes.size(); ++i) {
-        h ^= static_cast<unsigned char>(bytes[i]);
-        h *= 1099511628211ull;
-    }
+    const uint64_t h = Fnv1a(bytes.data(), bytes.size() - 8);
     std::memcpy(&bytes[bytes.size() - 8], &h, 8);
     return bytes;
 }
