@@ -32,26 +32,12 @@ namespace atmos {
 namespace {
 
 // out = 2 * in (whole output).
-struct DoubleStage {
-    TableView in;
-    TableOut out;
-    template <typename V>
-    void VisitTables(V& v) {
-        v(in);
-        v(out);
-    }
+struct DoubleStage : atmos_test::InOutStage {
     ATMOS_HD void operator()(int64_t i) const { out.data[i] = 2.0f * in.data[i]; }
 };
 
 // out += in (accumulated output).
-struct AddStage {
-    TableView in;
-    TableOut out;
-    template <typename V>
-    void VisitTables(V& v) {
-        v(in);
-        v(out);
-    }
+struct AddStage : atmos_test::InOutStage {
     ATMOS_HD void operator()(int64_t i) const { out.data[i] += in.data[i]; }
 };
 

@@ -179,6 +179,18 @@ std::string ErrorMessage(F f) {
     return "";
 }
 
+// The tables of a test stage (render/stages.h) that reads `in` and writes or
+// accumulates into `out`; the stage adds its operator().
+struct InOutStage {
+    atmos::TableView in;
+    atmos::TableOut out;
+    template <typename V>
+    void VisitTables(V& v) {
+        v(in);
+        v(out);
+    }
+};
+
 // A render request of `view` at width x height, without progress bars.
 inline atmos::RenderRequest QuietRequest(const atmos::View& view, int width, int height) {
     atmos::RenderRequest request;
