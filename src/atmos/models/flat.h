@@ -86,15 +86,11 @@ struct FlatOptics {
     }
 };
 
-struct FlatEvaluator {
-    FlatOptics optics;
-
-    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
-                                bool want_ground) const {
+struct FlatEvaluator : AnalyticEvaluator<FlatEvaluator, FlatOptics> {
+    // The segment inside the atmosphere (AnalyticEvaluator::Evaluate).
+    ATMOS_HD void Integrate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                            bool want_ground, const AtmosphereSegment& seg, RayResult* out) const {
         const AnalyticMedia& m = optics.m;
-        RayResult out;
-        AtmosphereSegment seg;
-        if (!BeginAnalyticRay(optics, camera, dir, sun, want_ground, &out, &seg)) return out;
         const MediaLengths l = optics.SegmentLengths(camera, dir, seg.t_start, seg.t_end);
         const Vec3d tau = m.Extinction(l.rayleigh, l.mie, l.ozone);
         const Vec3d p0 = camera + dir * seg.t_start;
@@ -107,10 +103,9 @@ struct FlatEvaluator {
                            m.mie_scattering * (l.mie * m.MiePhaseAt(nu))) *
                           e;
         const Vec3d t_view = Exp(-tau);
-        out.sky = Rgb(sky);
-        out.transmittance = Rgb(t_view);
-        if (want_ground && seg.hits_ground) out.ground = AnalyticGround(optics, p1, sun, t_view);
-        return out;
+        out->sky = Rgb(sky);
+        out->transmittance = Rgb(t_view);
+        if (want_ground && seg.hits_ground) out->ground = AnalyticGround(optics, p1, sun, t_view);
     }
 };
 
