@@ -3,6 +3,10 @@
 // the models' shipped data (data/neural/, data/hosek-wilkie-2012/).
 #pragma once
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 namespace atmos::detail {
 
 struct EmbeddedPreset {
@@ -19,5 +23,13 @@ extern const int kEmbeddedSpectrumCount;
 // data (data/hosek-wilkie-2012/*.json), each terminated by {nullptr, nullptr}.
 extern const EmbeddedPreset kEmbeddedNeuralWeights[];
 extern const EmbeddedPreset kEmbeddedHosekWilkie[];
+
+// The names of the first `count` entries of `files`, sorted.
+inline std::vector<std::string> SortedNames(const EmbeddedPreset* files, int count) {
+    std::vector<std::string> names;
+    for (int i = 0; i < count; ++i) names.emplace_back(files[i].name);
+    std::sort(names.begin(), names.end());
+    return names;
+}
 
 }  // namespace atmos::detail
