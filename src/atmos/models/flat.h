@@ -58,10 +58,7 @@ struct FlatOptics {
     // Optical lengths of the segment [t0, t1] of the ray origin + t dir.
     ATMOS_HD MediaLengths SegmentLengths(const Vec3d& origin, const Vec3d& dir, double t0,
                                          double t1) const {
-        const Vec3d p = origin + dir * t0;
-        const double r = Length(p);
-        const double mu = ClampCosine(Dot(p, dir) / r);
-        const double d = Max(t1 - t0, 0.0);
+        const auto [r, mu, d] = RaySegmentStartOf(origin, dir, t0, t1);
         MediaLengths l;
         l.rayleigh = SegmentFromToInfinity(FlatUpLength{m.rayleigh_H, m.bottom}, r, mu, d);
         l.mie = SegmentFromToInfinity(FlatUpLength{m.mie_H, m.bottom}, r, mu, d);

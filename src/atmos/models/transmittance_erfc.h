@@ -14,6 +14,7 @@
 
 #include "models/transmittance_common.h"
 #include "physics/analytic_media.h"
+#include "physics/analytic_optical_depth.h"
 
 namespace atmos {
 
@@ -21,10 +22,7 @@ struct ErfcTransmittanceOptics {
     AnalyticMedia m;
 
     ATMOS_HD Vec3d SegmentDepth(const Vec3d& origin, const Vec3d& dir, double t0, double t1) const {
-        const Vec3d p = origin + dir * t0;
-        const double r = Length(p);
-        const double mu = ClampCosine(Dot(p, dir) / r);
-        const double d = Max(t1 - t0, 0.0);
+        const auto [r, mu, d] = RaySegmentStartOf(origin, dir, t0, t1);
         return m.rayleigh_scattering * ErfcSegmentLength(r, mu, d, m.rayleigh_H, m.bottom) +
                m.mie_extinction * ErfcSegmentLength(r, mu, d, m.mie_H, m.bottom);
     }

@@ -50,10 +50,7 @@ struct PolynomialTransmittanceOptics {
     PolynomialSigmoid fit;
 
     ATMOS_HD Vec3d SegmentDepth(const Vec3d& origin, const Vec3d& dir, double t0, double t1) const {
-        const Vec3d p = origin + dir * t0;
-        const double r = Length(p);
-        const double mu = ClampCosine(Dot(p, dir) / r);
-        const double d = Max(t1 - t0, 0.0);
+        const auto [r, mu, d] = RaySegmentStartOf(origin, dir, t0, t1);
         Vec3d tau;
         for (int c = 0; c < 3; ++c)
             tau[c] = SegmentFromToInfinity(PolynomialChannel{&fit, c}, r, mu, d);
