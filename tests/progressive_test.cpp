@@ -108,6 +108,16 @@ std::string WriteCoinCheckpoint(const CoinModel& model, const char* dir_name,
     return request->checkpoint + ".bin";
 }
 
+// Resumes request's checkpoint to 12 samples per pixel into *resumed and
+// returns how many passes that rendered.
+int ResumeToTwelveSamples(const CoinModel& model, RenderRequest* request, Image* resumed) {
+    request->monte_carlo.spp = 12;
+    request->resume = true;
+    const int before = model.passes_rendered;
+    model.Render(*request, resumed);
+    return model.passes_rendered - before;
+}
+
 // A checkpoint's bytes with the trailing FNV-1a checksum recomputed (after an edit).
 std::string ResumCheckpoint(std::string bytes) {
     const uint64_t h = Fnv1a(bytes.data(), bytes.size() - 8);
@@ -179,12 +189,8 @@ TEST(Progressive, ResumesACheckpointOfAnyMonteCarloModel) {
     request.checkpoint = (dir / "coin").string();
     Image partial;
     model.Render(request, &partial);
-    request.monte_carlo.spp = 12;
-    request.resume = true;
     Image resumed;
-    const int before = model.passes_rendered;
-    model.Render(request, &resumed);
-    EXPECT_EQ(model.passes_rendered - before, 2);  // passes 3 and 4 only
+    EXPECT_EQ(ResumeToTwelveSamples(model, &request, &resumed), 2);  // passes 3 and 4 only
     ASSERT_EQ(resumed.size(), full.size());
     EXPECT_EQ(std::memcmp(resumed.data(), full.data(), full.size() * sizeof(float)), 0);
     // Another seed or pass size is another render: refused.
@@ -386,12 +392,8 @@ TEST(Progressive, RendersToANoiseTargetOrTheCap) {
     request.monte_carlo.spp = 6;
     request.checkpoint = (dir / "coin").string();
     model.Render(request, &quick);
-    request.monte_carlo.spp = 12;
-    request.resume = true;
     Image resumed;
-    const int before = model.passes_rendered;
-    model.Render(request, &resumed);
-    EXPECT_EQ(model.passes_rendered - before, 2);
+    EXPECT_EQ(ResumeToTwelveSamples(model, &request, &resumed), 2);
     EXPECT_EQ(report.samples, 12);
     EXPECT_EQ(std::memcmp(resumed.data(), plain.data(), plain.size() * sizeof(float)), 0);
     // A noise target out of range is one clear error.
