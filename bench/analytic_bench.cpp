@@ -12,6 +12,7 @@
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "atmos/view.h"
+#include "bench_util.h"
 #include "models/flat.h"
 #include "models/oneil.h"
 #include "models/preetham.h"
@@ -28,33 +29,14 @@
 namespace atmos {
 namespace {
 
-template <typename M>
-void BenchModel(benchmark::State& state, const char* name, const char* view_name) {
-    std::unique_ptr<Model> base = CreateModel(name);
-    base->Prepare(EarthAtmosphere());
-    const auto evaluator = dynamic_cast<const M&>(*base).MakeEvaluator();
-    const View view = GetView(view_name, EarthAtmosphere());
-    std::vector<Vec3d> dirs;
-    for (int i = 0; i < 64 * 36; ++i) {
-        dirs.push_back(view.camera.RayDirection(i % 64, i / 64, 64, 36));
-    }
-    size_t i = 0;
-    for (auto _ : state) {
-        RayResult r = evaluator.Evaluate(view.camera.position, dirs[i], view.sun_direction, true);
-        benchmark::DoNotOptimize(r);
-        i = (i + 1) % dirs.size();
-    }
-    state.SetItemsProcessed(state.iterations());
-}
-
-#define ATMOS_ANALYTIC_BENCH(Type, name)                       \
-    void BM_Analytic_##Type(benchmark::State& state) {         \
-        BenchModel<Type>(state, name, "ground-sunrise");       \
-    }                                                          \
-    BENCHMARK(BM_Analytic_##Type);                             \
-    void BM_Analytic_##Type##_Space(benchmark::State& state) { \
-        BenchModel<Type>(state, name, "space");                \
-    }                                                          \
+#define ATMOS_ANALYTIC_BENCH(Type, name)                             \
+    void BM_Analytic_##Type(benchmark::State& state) {               \
+        BenchModelEvaluate<Type>(state, name, {}, "ground-sunrise"); \
+    }                                                                \
+    BENCHMARK(BM_Analytic_##Type);                                   \
+    void BM_Analytic_##Type##_Space(benchmark::State& state) {       \
+        BenchModelEvaluate<Type>(state, name, {}, "space");          \
+    }                                                                \
     BENCHMARK(BM_Analytic_##Type##_Space);
 
 ATMOS_ANALYTIC_BENCH(OneilModel, "oneil")

@@ -11,6 +11,7 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/view.h"
+#include "bench_util.h"
 #include "models/atmosphere_plus.h"
 #include "render/render.h"
 
@@ -57,18 +58,7 @@ void RunAplusEvaluate(benchmark::State& state, const char* view_name) {
     e.mapping.height = atm.top_radius - atm.bottom_radius;
     e.scattering = tables.scattering.view();
     e.transmittance = tables.transmittance.view();
-    const View view = GetView(view_name, atm);
-    std::vector<Vec3d> dirs;
-    for (int i = 0; i < 64 * 36; ++i) {
-        dirs.push_back(view.camera.RayDirection(i % 64, (i / 64) % 36, 64, 36));
-    }
-    size_t i = 0;
-    for (auto _ : state) {
-        RayResult r = e.Evaluate(view.camera.position, dirs[i], view.sun_direction, true);
-        benchmark::DoNotOptimize(r);
-        i = (i + 1) % dirs.size();
-    }
-    state.SetItemsProcessed(state.iterations());
+    BenchEvaluate(state, e, GetView(view_name, atm));
 }
 
 void BM_AplusEvaluateGroundSunrise(benchmark::State& state) {

@@ -15,6 +15,7 @@
 #include "atmos/atmosphere.h"
 #include "atmos/view.h"
 #include "base/parallel.h"
+#include "bench_util.h"
 #include "models/bruneton.h"
 #include "models/bruneton_stages.h"
 #include "render/render.h"
@@ -78,18 +79,7 @@ const Prepared& GetPrepared() {
 
 void RunView(benchmark::State& state, const char* view_name) {
     const BrunetonEvaluator& e = GetPrepared().evaluator;
-    const View view = GetView(view_name, EarthAtmosphere());
-    std::vector<Vec3d> dirs;
-    for (int i = 0; i < 64 * 36; ++i) {
-        dirs.push_back(view.camera.RayDirection(i % 64, (i / 64) % 36, 64, 36));
-    }
-    size_t i = 0;
-    for (auto _ : state) {
-        RayResult r = e.Evaluate(view.camera.position, dirs[i], view.sun_direction, true);
-        benchmark::DoNotOptimize(r);
-        i = (i + 1) % dirs.size();
-    }
-    state.SetItemsProcessed(state.iterations());
+    BenchEvaluate(state, e, GetView(view_name, EarthAtmosphere()));
 }
 
 void BM_BrunetonEvaluateGroundSunrise(benchmark::State& state) { RunView(state, "ground-sunrise"); }

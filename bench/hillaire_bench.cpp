@@ -19,6 +19,7 @@
 #include "atmos/image.h"
 #include "atmos/view.h"
 #include "base/parallel.h"
+#include "bench_util.h"
 #include "models/hillaire.h"
 #include "render/render.h"
 #include "render/stages.h"
@@ -90,17 +91,23 @@ void BM_HillaireFrameTables(benchmark::State& state) {
 }
 BENCHMARK(BM_HillaireFrameTables)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// A 1920 x 1080 render of view kViews[range(0)] (the label).
+RenderRequest FrameRequest(benchmark::State& state, const HillaireModel& model) {
+    RenderRequest request;
+    request.view = GetView(kViews[state.range(0)], model.atmosphere());
+    state.SetLabel(request.view.name);
+    request.width = kWidth;
+    request.height = kHeight;
+    request.show_progress = false;
+    return request;
+}
+
 // The per-pixel loop alone at 1920 x 1080 (frame tables built outside the timing).
 void BM_HillaireRenderPixels(benchmark::State& state) {
     ThreadLimit limit(kThreads);
     auto model = PreparedModel();
-    const View view = GetView(kViews[state.range(0)], model->atmosphere());
-    state.SetLabel(view.name);
-    RenderRequest request;
-    request.view = view;
-    request.width = kWidth;
-    request.height = kHeight;
-    request.show_progress = false;
+    const RenderRequest request = FrameRequest(state, *model);
+    const View& view = request.view;
     const PixelSetup setup = MakePixelSetup(request, model->atmosphere());
     auto frame = model->BuildFrame(view.camera, view.sun_direction,
                                    static_cast<double>(kWidth) / kHeight, true);
@@ -114,13 +121,7 @@ BENCHMARK(BM_HillaireRenderPixels)->DenseRange(0, 3)->Unit(benchmark::kMilliseco
 void BM_HillaireRenderFrame(benchmark::State& state) {
     ThreadLimit limit(kThreads);
     auto model = PreparedModel();
-    const View view = GetView(kViews[state.range(0)], model->atmosphere());
-    state.SetLabel(view.name);
-    RenderRequest request;
-    request.view = view;
-    request.width = kWidth;
-    request.height = kHeight;
-    request.show_progress = false;
+    const RenderRequest request = FrameRequest(state, *model);
     Image image;
     for (auto _ : state) model->Render(request, &image);
 }
@@ -135,17 +136,7 @@ void BM_HillaireEvaluate(benchmark::State& state) {
     state.SetLabel(view.name);
     auto frame = model->BuildFrame(view.camera, view.sun_direction, 16.0 / 9.0, true);
     const HillaireEvaluator e = frame->Evaluator();
-    std::vector<Vec3d> dirs;
-    for (int i = 0; i < 64 * 36; ++i) {
-        dirs.push_back(view.camera.RayDirection(i % 64, i / 64, 64, 36));
-    }
-    size_t i = 0;
-    for (auto _ : state) {
-        RayResult r = e.Evaluate(view.camera.position, dirs[i], view.sun_direction, true);
-        benchmark::DoNotOptimize(r);
-        i = (i + 1) % dirs.size();
-    }
-    state.SetItemsProcessed(state.iterations());
+    BenchEvaluate(state, e, view);
 }
 BENCHMARK(BM_HillaireEvaluate)->Arg(0)->Arg(3);
 

@@ -9,6 +9,7 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/view.h"
+#include "bench_util.h"
 #include "models/empty.h"
 #include "models/naive.h"
 #include "render/render.h"
@@ -16,25 +17,9 @@
 namespace atmos {
 namespace {
 
-std::vector<Vec3d> Directions(const View& view, int n) {
-    std::vector<Vec3d> dirs;
-    for (int i = 0; i < n; ++i) {
-        dirs.push_back(view.camera.RayDirection(i % 64, (i / 64) % 36, 64, 36));
-    }
-    return dirs;
-}
-
 template <typename Evaluator>
 void RunEvaluator(benchmark::State& state, const Evaluator& evaluator, const char* view_name) {
-    const View view = GetView(view_name, EarthAtmosphere());
-    const std::vector<Vec3d> dirs = Directions(view, 64 * 36);
-    size_t i = 0;
-    for (auto _ : state) {
-        RayResult r = evaluator.Evaluate(view.camera.position, dirs[i], view.sun_direction, true);
-        benchmark::DoNotOptimize(r);
-        i = (i + 1) % dirs.size();
-    }
-    state.SetItemsProcessed(state.iterations());
+    BenchEvaluate(state, evaluator, GetView(view_name, EarthAtmosphere()));
 }
 
 void BM_EmptyEvaluate(benchmark::State& state) {

@@ -14,17 +14,14 @@
 #include "models/atmosphere_plus.h"
 #include "models/atmosphere_plus_stages.h"
 #include "render/stages.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
 
-template <typename S>
-constexpr bool kIsDeviceStage = std::is_trivially_copyable<S>::value&& HasDeviceStage<S>::value;
-static_assert(kIsDeviceStage<AplusTransmittanceStage>, "device stage");
-static_assert(kIsDeviceStage<AplusSingleScatteringStage>, "device stage");
-static_assert(kIsDeviceStage<AplusGatherStage>, "device stage");
-static_assert(kIsDeviceStage<AplusOrderStage>, "device stage");
-static_assert(kIsDeviceStage<AplusAddStage>, "device stage");
+static_assert(atmos_test::kAreDeviceStages<AplusTransmittanceStage, AplusSingleScatteringStage,
+                                           AplusGatherStage, AplusOrderStage, AplusAddStage>,
+              "device stages");
 
 AplusSettings Small(const AtmosphereParameters& atm) {
     AplusSettings s;

@@ -23,6 +23,7 @@
 #include "atmos/view.h"
 #include "models/atmosphere_plus.h"
 #include "render/render.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -37,11 +38,7 @@ struct Errors {
 std::vector<Rgb> RenderWith(const AtmospherePlusEvaluator* table,
                             const AtmospherePlusDirectEvaluator* direct,
                             const AtmosphereParameters& atm, const View& view) {
-    RenderRequest request;
-    request.view = view;
-    request.width = kW;
-    request.height = kH;
-    request.show_progress = false;
+    RenderRequest request = atmos_test::QuietRequest(view, kW, kH);
     const PixelSetup setup = MakePixelSetup(request, atm);
     Image image;
     image.Resize(kW, kH);
@@ -74,6 +71,19 @@ Errors Compare(const std::vector<Rgb>& a, const std::vector<Rgb>& b, float expos
     Errors e;
     e.rel_rmse = den > 0.0 ? std::sqrt(num / den) : 0.0;
     e.display_rmse = std::sqrt(disp / (3.0 * static_cast<double>(a.size())));
+    return e;
+}
+
+// The evaluator of tables `t` built with settings `s` for `atm`.
+AtmospherePlusEvaluator MakeEval(const AtmosphereParameters& atm, const AplusSettings& s,
+                                 const AplusTables& t) {
+    AtmospherePlusEvaluator e;
+    e.atm = atm;
+    e.mapping = s.mapping;
+    e.mapping.bottom_radius = atm.bottom_radius;
+    e.mapping.height = atm.top_radius - atm.bottom_radius;
+    e.scattering = t.scattering.view();
+    e.transmittance = t.transmittance.view();
     return e;
 }
 
@@ -129,13 +139,7 @@ TEST(AtmospherePlusStudy, DISABLED_ParameterizationTable) {
             s.transmittance_width = 8;  // transmittance is not measured here
             s.transmittance_height = 8;
             const AplusTables t = AplusPrecompute(atm, s);
-            AtmospherePlusEvaluator e;
-            e.atm = atm;
-            e.mapping = s.mapping;
-            e.mapping.bottom_radius = atm.bottom_radius;
-            e.mapping.height = atm.top_radius - atm.bottom_radius;
-            e.scattering = t.scattering.view();
-            e.transmittance = t.transmittance.view();
+            const AtmospherePlusEvaluator e = MakeEval(atm, s, t);
             const double mib =
                 static_cast<double>(t.scattering.size() * sizeof(float)) / (1024.0 * 1024.0);
             std::printf("| %s | %dx%dx%d | %.2f |", c.name.c_str(), size[0], size[1], size[2], mib);
@@ -157,18 +161,6 @@ TEST(AtmospherePlusStudy, DISABLED_ParameterizationTable) {
 // The full model (5 orders, the seed's 6 x 12 gather): table error against the
 // same numerics in a 64 x 256 x 64 horizon-centric table (stand-in), and the
 // effect of the seed's coarse gather against a 24 x 48 gather (same table).
-AtmospherePlusEvaluator MakeEval(const AtmosphereParameters& atm, const AplusSettings& s,
-                                 const AplusTables& t) {
-    AtmospherePlusEvaluator e;
-    e.atm = atm;
-    e.mapping = s.mapping;
-    e.mapping.bottom_radius = atm.bottom_radius;
-    e.mapping.height = atm.top_radius - atm.bottom_radius;
-    e.scattering = t.scattering.view();
-    e.transmittance = t.transmittance.view();
-    return e;
-}
-
 TEST(AtmospherePlusStudy, DISABLED_MultipleScatteringTable) {
     AtmosphereParameters atm = LoadAtmosphere("earth-atmosphere-plus");
     atm.solar_irradiance = Vec3d(1.0);

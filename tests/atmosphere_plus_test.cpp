@@ -21,6 +21,7 @@
 #include "models/naive.h"
 #include "physics/transmittance.h"
 #include "render/render.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -518,11 +519,7 @@ TEST(AtmospherePlus, RendersAllParameterizationsAndRejectsBadOptions) {
     for (const char* p : {"linear", "nonlinear", "power", "horizon"}) {
         auto model = SmallModel({{"parameterization", p}});
         model->Prepare(SeedAtmosphere());
-        RenderRequest request;
-        request.view = view;
-        request.width = 32;
-        request.height = 18;
-        request.show_progress = false;
+        RenderRequest request = atmos_test::QuietRequest(view, 32, 18);
         Image image;
         model->Render(request, &image);
         double sum = 0.0;

@@ -13,6 +13,7 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/error.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -75,28 +76,6 @@ std::vector<std::string> ChangedFields(const AtmosphereParameters& a,
     }
     return changed;
 }
-
-// Runs `f`, expects atmos::Error, and returns its message ("" if none was thrown).
-template <typename F>
-std::string ErrorMessage(F f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "threw a non-atmos exception: " << e.what();
-        return "";
-    }
-    ADD_FAILURE() << "did not throw";
-    return "";
-}
-
-#define EXPECT_ERROR_CONTAINS(statement, text)                                 \
-    do {                                                                       \
-        const std::string message_ = ErrorMessage([&] { (void)(statement); }); \
-        EXPECT_NE(message_.find(text), std::string::npos)                      \
-            << "message: \"" << message_ << "\" lacks \"" << (text) << "\"";   \
-    } while (0)
 
 std::filesystem::path TempDir() {
     const char* env = std::getenv("ATMOS_TEST_TMP");
@@ -391,7 +370,7 @@ TEST(Atmosphere, LaterOverridesWin) {
 TEST(Atmosphere, ValidateNamesTheField) {
     AtmosphereParameters a = EarthAtmosphere();
     a.mie_phase_g = 1.5;
-    EXPECT_EQ(ErrorMessage([&] { ValidateAtmosphere(a); }),
+    EXPECT_EQ(atmos_test::ErrorMessage([&] { ValidateAtmosphere(a); }),
               "invalid atmosphere field 'mie_phase_g': 1.5 is outside the allowed range (-1, 1)");
 
     a = EarthAtmosphere();
@@ -461,7 +440,7 @@ TEST(Atmosphere, RejectsNegativeScattering) {
 
 TEST(Atmosphere, RejectsExtinctionBelowScattering) {
     const std::string message =
-        ErrorMessage([] { LoadAtmosphere("earth", {"mie_extinction=3e-6"}); });
+        atmos_test::ErrorMessage([] { LoadAtmosphere("earth", {"mie_extinction=3e-6"}); });
     EXPECT_NE(message.find("'mie_extinction[0]'"), std::string::npos) << message;
     EXPECT_NE(message.find("mie_scattering"), std::string::npos) << message;
 }
@@ -496,7 +475,8 @@ TEST(Atmosphere, RejectsMissingOrMistypedField) {
 }
 
 TEST(Atmosphere, RejectsUnknownSetField) {
-    const std::string message = ErrorMessage([] { LoadAtmosphere("earth", {"xyz=1"}); });
+    const std::string message =
+        atmos_test::ErrorMessage([] { LoadAtmosphere("earth", {"xyz=1"}); });
     EXPECT_NE(message.find("unknown atmosphere field 'xyz' in --set xyz=1 (fields: "),
               std::string::npos)
         << message;
@@ -527,7 +507,7 @@ TEST(Atmosphere, RejectsMalformedJson) {
 
 TEST(Atmosphere, RejectsNonexistentFile) {
     const std::string path = (TempDir() / "no_such_atmosphere.json").string();
-    const std::string message = ErrorMessage([&] { LoadAtmosphere(path); });
+    const std::string message = atmos_test::ErrorMessage([&] { LoadAtmosphere(path); });
     EXPECT_NE(message.find(path), std::string::npos) << message;
     EXPECT_NE(message.find("earth-bruneton"), std::string::npos) << message;  // lists presets
     EXPECT_ERROR_CONTAINS(LoadAtmosphere(TempDir().string()), TempDir().string());

@@ -19,44 +19,20 @@
 #include <vector>
 
 #include "atmos/atmosphere.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path SweepDir() {
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
-    dir /= "bad_input_" + std::to_string(getpid());
-    fs::create_directories(dir);
-    return dir;
-}
+using atmos_test::Slurp;
+using Outcome = atmos_test::CommandOutcome;
 
-std::string Slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
-
-struct Outcome {
-    int status = -1;
-    std::string out, err;
-};
+fs::path SweepDir() { return atmos_test::TestTmpDir("bad_input_" + std::to_string(getpid())); }
 
 Outcome Atmos(const fs::path& dir, const std::string& args, const std::string& input) {
     static int counter = 0;
-    const std::string id = std::to_string(++counter);
-    const fs::path out = dir / ("out" + id), err = dir / ("err" + id), in = dir / ("in" + id);
-    std::ofstream(in) << input;
-    const std::string cmd = std::string(ATMOS_CLI_PATH) + " " + args + " < " + in.string() + " > " +
-                            out.string() + " 2> " + err.string();
-    const int raw = std::system(cmd.c_str());
-    Outcome r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = Slurp(out);
-    r.err = Slurp(err);
-    return r;
+    return atmos_test::RunAtmosWithInput(dir, std::to_string(++counter), args, input);
 }
 
 struct Case {

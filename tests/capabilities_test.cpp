@@ -16,6 +16,7 @@
 #include "harness/spectral_run.h"
 #include "models/evaluator_model.h"
 #include "models/model_factory.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
@@ -127,11 +128,8 @@ TEST_F(GreyRegistered, BenchRunsIt) {
     EXPECT_EQ(picked.back(), "caps-test-grey");
     std::unique_ptr<Model> model = CreateModel(ParseModelSpec("caps-test-grey:level=0.5"));
     model->Prepare(EarthAtmosphere());
-    RenderRequest request;
-    request.view = StandardViews(EarthAtmosphere()).front();
-    request.width = 4;
-    request.height = 2;
-    request.show_progress = false;
+    RenderRequest request =
+        atmos_test::QuietRequest(StandardViews(EarthAtmosphere()).front(), 4, 2);
     Image image;
     model->Render(request, &image);
     EXPECT_EQ(image.width(), 4);

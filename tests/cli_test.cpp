@@ -27,49 +27,26 @@
 #include "atmos/model.h"
 #include "base/parallel.h"
 #include "io/image_formats.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path TempDir() {
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
-    dir /= "cli";
-    fs::create_directories(dir);
-    return dir;
-}
+using atmos_test::Slurp;
+using Result = atmos_test::CommandOutcome;
 
-struct Result {
-    int status = -1;
-    std::string out;
-    std::string err;
-};
-
-std::string Slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
+fs::path TempDir() { return atmos_test::TestTmpDir("cli"); }
 
 // Runs `atmos ARGS` (stdin from `input` if not empty), capturing both streams.
 Result RunAtmos(const std::string& args, const std::string& input = "") {
     static int counter = 0;
-    const fs::path dir = TempDir();
     // Unique per process: ctest runs each test in its own process, in parallel.
     const std::string id = std::to_string(getpid()) + "_" + std::to_string(++counter);
-    const fs::path out = dir / ("out" + id), err = dir / ("err" + id), in = dir / ("in" + id);
-    std::ofstream(in) << input;
-    const std::string cmd = std::string(ATMOS_CLI_PATH) + " " + args + " < " + in.string() + " > " +
-                            out.string() + " 2> " + err.string();
-    const int raw = std::system(cmd.c_str());
-    Result r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = Slurp(out);
-    r.err = Slurp(err);
-    return r;
+    return atmos_test::RunAtmosWithInput(TempDir(), id, args, input);
 }
+
+bool HaveStrace() { return std::system("strace -o /dev/null true > /dev/null 2>&1") == 0; }
 
 // An error: non-zero exit and exactly one line on stderr, mentioning `needle`.
 void ExpectError(const std::string& args, const std::string& needle,
@@ -427,12 +404,8 @@ TEST(Cli, MonteCarloFlags) {
 // render of 4 spp is checkpointed, extending it to 8 is killed at the k-th such
 // call, and the resumed render is the uninterrupted one.
 TEST(Cli, CheckpointSurvivesAKillAtEveryWriteAndRename) {
-    if (std::system("strace -o /dev/null true > /dev/null 2>&1") != 0) {
-        GTEST_SKIP() << "strace is not available";
-    }
-    const fs::path dir = TempDir() / "kill";
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    if (!HaveStrace()) GTEST_SKIP() << "strace is not available";
+    const fs::path dir = atmos_test::FreshTestTmpDir("cli/kill");
     const std::string base =
         "render --model reference --view plane-dawn --size 24x12 -q --seed 3 "
         "--pass-spp 2 --checkpoint " +
@@ -471,9 +444,7 @@ TEST(Cli, CheckpointSurvivesAKillAtEveryWriteAndRename) {
 // Issue 18 item 10: the checkpoint is deleted once the image is written,
 // unless --keep-checkpoint.
 TEST(Cli, CheckpointDeletedAfterSuccessUnlessKept) {
-    const fs::path dir = TempDir() / "ckpt_delete";
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = atmos_test::FreshTestTmpDir("cli/ckpt_delete");
     const std::string base = "render --model reference --view plane-dawn --size 8x4 -q --spp 2 ";
     ASSERT_EQ(RunAtmos(base + "-o " + (dir / "a.exr").string()).status, 0);
     EXPECT_TRUE(fs::exists(dir / "a.exr"));
@@ -486,9 +457,7 @@ TEST(Cli, CheckpointDeletedAfterSuccessUnlessKept) {
 // writes the checkpoint and stops with one line saying how to resume.
 TEST(Cli, SigintCheckpointsAndStops) {
     if (!fs::exists("/proc/self/status")) GTEST_SKIP() << "no /proc";
-    const fs::path dir = TempDir() / "sigint";
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = atmos_test::FreshTestTmpDir("cli/sigint");
     // The render is spawned directly, with SIGINT and SIGTERM at their default
     // action and unblocked, whatever this test inherited: a CI that starts the
     // suite with SIGINT blocked (or ignored, as a shell's background job is)
@@ -501,48 +470,13 @@ TEST(Cli, SigintCheckpointsAndStops) {
         ATMOS_CLI_PATH, "render",     "--model", "reference", "--view",
         "plane-dawn",   "--size",     "8x4",     "-q",        "--spp",
         "200000",       "--pass-spp", "1",       "-o",        (dir / "i.exr").string()};
-    std::vector<char*> argv;
-    for (std::string& w : argv_text) argv.push_back(w.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t files;
-    posix_spawn_file_actions_init(&files);
-    posix_spawn_file_actions_addopen(&files, 1, "/dev/null", O_WRONLY, 0);
-    const std::string err_path = (dir / "err").string();
-    posix_spawn_file_actions_addopen(&files, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                     0644);
-    posix_spawnattr_t attr;
-    posix_spawnattr_init(&attr);
-    sigset_t none, stops;
-    sigemptyset(&none);
-    sigemptyset(&stops);
-    sigaddset(&stops, SIGINT);
-    sigaddset(&stops, SIGTERM);
-    posix_spawnattr_setsigmask(&attr, &none);
-    posix_spawnattr_setsigdefault(&attr, &stops);
-    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
     pid_t pid = 0;
-    const int spawned = posix_spawn(&pid, ATMOS_CLI_PATH, &files, &attr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&files);
-    posix_spawnattr_destroy(&attr);
+    const int spawned = atmos_test::SpawnWithDefaultSignals(argv_text, (dir / "err").string(),
+                                                            {SIGINT, SIGTERM}, &pid);
     ASSERT_EQ(spawned, 0) << std::strerror(spawned);
-    // Wait (no time limit: ctest's own bounds it) until the render catches
-    // SIGINT or has ended.
-    const std::string status_path = "/proc/" + std::to_string(pid) + "/status";
-    bool catching = false;
+    // Wait until the render catches SIGINT or has ended.
     int raw = 0;
-    bool ended = false;
-    while (!catching && !ended) {
-        std::ifstream status(status_path);
-        for (std::string line; std::getline(status, line);) {
-            if (line.rfind("SigCgt:", 0) == 0) {
-                catching = (std::stoull(line.substr(7), nullptr, 16) >> (SIGINT - 1)) & 1u;
-            }
-        }
-        if (!catching) {
-            ended = waitpid(pid, &raw, WNOHANG) == pid;
-            if (!ended) usleep(5000);
-        }
-    }
+    const bool ended = atmos_test::WaitUntilCatching(pid, SIGINT, 5000, &raw);
     ASSERT_FALSE(ended) << "the render ended before it caught SIGINT: " << Slurp(dir / "err");
     ASSERT_EQ(kill(pid, SIGINT), 0);
     ASSERT_EQ(waitpid(pid, &raw, 0), pid);
@@ -561,12 +495,8 @@ TEST(Cli, SigintCheckpointsAndStops) {
 // at the third commit (strace) stops the render inside its first pass with one
 // line, and --resume finishes it to exactly the uninterrupted image.
 TEST(Cli, SigintInsideAPassCheckpointsAndResumesToTheSameImage) {
-    if (std::system("strace -o /dev/null true > /dev/null 2>&1") != 0) {
-        GTEST_SKIP() << "strace is not available";
-    }
-    const fs::path dir = TempDir() / "sigint_band";
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    if (!HaveStrace()) GTEST_SKIP() << "strace is not available";
+    const fs::path dir = atmos_test::FreshTestTmpDir("cli/sigint_band");
     const std::string base =
         "render --model reference --view plane-dawn --size 24x12 -q --seed 5 --spp 4 "
         "--pass-spp 2 --checkpoint-every 0 --checkpoint " +
@@ -832,9 +762,7 @@ TEST(Cli, ValidateKiderOnTwoCaptures) {
 // temporary behind (std::ofstream left a truncated file under the final name).
 TEST(Cli, TextOutputsAreWrittenAtomically) {
     if (std::system("bash -c 'ulimit -f 1' > /dev/null 2>&1") != 0) GTEST_SKIP() << "no bash";
-    const fs::path dir = TempDir() / "atomic_text";
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = atmos_test::FreshTestTmpDir("cli/atomic_text");
     const fs::path data = fs::path(ATMOS_SOURCE_DIR) / "tests" / "data" / "kider-2013";
     // 40 queries for sample's CSV outputs (each over 1 KiB).
     {

@@ -26,31 +26,18 @@
 #include "models/hillaire.h"
 #include "render/render.h"
 #include "render/stages.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
 
 // out = 2 * in (whole output).
-struct DoubleStage {
-    TableView in;
-    TableOut out;
-    template <typename V>
-    void VisitTables(V& v) {
-        v(in);
-        v(out);
-    }
+struct DoubleStage : atmos_test::InOutStage {
     ATMOS_HD void operator()(int64_t i) const { out.data[i] = 2.0f * in.data[i]; }
 };
 
 // out += in (accumulated output).
-struct AddStage {
-    TableView in;
-    TableOut out;
-    template <typename V>
-    void VisitTables(V& v) {
-        v(in);
-        v(out);
-    }
+struct AddStage : atmos_test::InOutStage {
     ATMOS_HD void operator()(int64_t i) const { out.data[i] += in.data[i]; }
 };
 
@@ -391,11 +378,7 @@ TEST(EmulatedDevice, TablesStayOnTheDeviceFromPrepareToRender) {
         std::unique_ptr<Model> model = CreateModel(name);
         const BackendScope scope(Backend::kEmulatedDevice);
         model->Prepare(atm);
-        RenderRequest request;
-        request.view = GetView("ground-sunrise", atm);
-        request.width = 8;
-        request.height = 4;
-        request.show_progress = false;
+        RenderRequest request = atmos_test::QuietRequest(GetView("ground-sunrise", atm), 8, 4);
         std::vector<StageTime> log;
         const StageLogScope logging(&log);
         Image image;

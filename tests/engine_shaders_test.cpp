@@ -13,38 +13,20 @@
 #include <string>
 #include <vector>
 
+#include "io/engine_shaders.h"
+#include "test_util.h"
+
 namespace {
 
 namespace fs = std::filesystem;
+using atmos::RunShellCommand;
+using atmos_test::Slurp;
 
-fs::path TempDir() {
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
-    dir /= "engine_shaders";
-    fs::create_directories(dir);
-    return dir;
-}
-
-int Shell(const std::string& command, std::string* output) {
-    output->clear();
-    std::FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-    if (!pipe) return -1;
-    char buffer[4096];
-    size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) output->append(buffer, n);
-    return pclose(pipe);
-}
+fs::path TempDir() { return atmos_test::TestTmpDir("engine_shaders"); }
 
 bool Have(const char* tool) {
     std::string out;
-    return Shell(std::string("command -v ") + tool, &out) == 0;
-}
-
-std::string Read(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    return RunShellCommand(std::string("command -v ") + tool, &out) == 0;
 }
 
 struct BakeCase {
@@ -73,9 +55,9 @@ TEST(EngineShaders, EveryStageCompilesAndTranslates) {
         const fs::path dir = TempDir() / c.dir;
         fs::remove_all(dir);
         std::string out;
-        ASSERT_EQ(Shell(std::string(ATMOS_CLI_PATH) + " bake -q --model " + c.model + " -o " +
-                            dir.string(),
-                        &out),
+        ASSERT_EQ(RunShellCommand(std::string(ATMOS_CLI_PATH) + " bake -q --model " + c.model +
+                                      " -o " + dir.string(),
+                                  &out),
                   0)
             << out;
         const fs::path shaders = dir / "shaders";
@@ -87,19 +69,19 @@ TEST(EngineShaders, EveryStageCompilesAndTranslates) {
         for (const std::string& stage : c.stages) {
             const fs::path source = shaders / "vulkan" / stage;
             ASSERT_TRUE(fs::exists(source)) << source;
-            const std::string text = Read(source);
+            const std::string text = Slurp(source);
             EXPECT_EQ(text.rfind("#version 450\n", 0), 0u) << source;
             // No loose uniform outside a block (illegal in Vulkan GLSL).
             EXPECT_EQ(text.find("\nuniform vec"), std::string::npos) << source;
             EXPECT_EQ(text.find("\nuniform float"), std::string::npos) << source;
             // 1. The Vulkan GLSL compiles as it is.
             const fs::path spv = TempDir() / "check.spv";
-            EXPECT_EQ(Shell("glslangValidator -V --target-env vulkan1.0 -o " + spv.string() + " " +
-                                source.string(),
-                            &out),
+            EXPECT_EQ(RunShellCommand("glslangValidator -V --target-env vulkan1.0 -o " +
+                                          spv.string() + " " + source.string(),
+                                      &out),
                       0)
                 << source << ": " << out;
-            EXPECT_EQ(Shell("spirv-val --target-env vulkan1.0 " + spv.string(), &out), 0)
+            EXPECT_EQ(RunShellCommand("spirv-val --target-env vulkan1.0 " + spv.string(), &out), 0)
                 << source << ": " << out;
             // 2. The bake's SPIR-V, HLSL and Metal exist; the SPIR-V is valid.
             std::string stem = stage;
@@ -111,9 +93,10 @@ TEST(EngineShaders, EveryStageCompilesAndTranslates) {
             ASSERT_TRUE(fs::exists(baked_spv)) << baked_spv;
             ASSERT_TRUE(fs::exists(hlsl)) << hlsl;
             ASSERT_TRUE(fs::exists(metal)) << metal;
-            EXPECT_EQ(Shell("spirv-val --target-env vulkan1.0 " + baked_spv.string(), &out), 0)
+            EXPECT_EQ(
+                RunShellCommand("spirv-val --target-env vulkan1.0 " + baked_spv.string(), &out), 0)
                 << baked_spv << ": " << out;
-            const std::string metal_text = Read(metal);
+            const std::string metal_text = Slurp(metal);
             const char* entry = kind == "vert"   ? "vertex "
                                 : kind == "frag" ? "fragment "
                                                  : "kernel ";
@@ -122,14 +105,14 @@ TEST(EngineShaders, EveryStageCompilesAndTranslates) {
             // 3. The HLSL round-trips: glslang's HLSL front end compiles it back to
             // valid SPIR-V.
             const fs::path back = TempDir() / "roundtrip.spv";
-            EXPECT_EQ(Shell("glslangValidator -D -V -S " + kind + " -e main -o " + back.string() +
-                                " " + hlsl.string(),
-                            &out),
+            EXPECT_EQ(RunShellCommand("glslangValidator -D -V -S " + kind + " -e main -o " +
+                                          back.string() + " " + hlsl.string(),
+                                      &out),
                       0)
                 << hlsl << ": " << out;
-            EXPECT_EQ(Shell("spirv-val --target-env vulkan1.0 " + back.string(), &out), 0)
+            EXPECT_EQ(RunShellCommand("spirv-val --target-env vulkan1.0 " + back.string(), &out), 0)
                 << hlsl << ": " << out;
-            const std::string hlsl_text = Read(hlsl);
+            const std::string hlsl_text = Slurp(hlsl);
             if (kind != "vert") {  // the full-screen triangle reads no uniform
                 EXPECT_NE(hlsl_text.find("cbuffer AtmosFrame : register(b0)"), std::string::npos)
                     << hlsl;
@@ -137,7 +120,7 @@ TEST(EngineShaders, EveryStageCompilesAndTranslates) {
         }
         // The bindings: the frame block at 0, every sampler of the stage at its own binding.
         const std::string model_file = c.stages[0].substr(0, c.stages[0].find('.'));
-        const std::string bindings = Read(shaders / "vulkan" / (model_file + "_bindings.json"));
+        const std::string bindings = Slurp(shaders / "vulkan" / (model_file + "_bindings.json"));
         EXPECT_NE(bindings.find("\"binding\": 0, \"name\": \"AtmosFrame\""), std::string::npos);
         // hosek-wilkie has no tables: its constants are compiled into the shader.
         EXPECT_EQ(bindings.find("atmos_transmittance_texture") != std::string::npos,

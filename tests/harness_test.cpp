@@ -22,42 +22,23 @@
 #include "harness/loc.h"
 #include "harness/render_cache.h"
 #include "harness/shipped_references.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace atmos {
 namespace {
 
+using atmos_test::Slurp;
+using CliRun = atmos_test::CommandOutcome;
+
 fs::path TempDir(const std::string& name) {
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
-    dir /= "harness_" + name + "_" + std::to_string(getpid());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
+    return atmos_test::FreshTestTmpDir("harness_" + name + "_" + std::to_string(getpid()));
 }
 
-std::string Slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
-
-struct CliRun {
-    int status = -1;
-    std::string out, err;
-};
 // A shell command line, its stdout and stderr.
 CliRun Shell(const std::string& command, const fs::path& dir) {
-    const fs::path out = dir / "stdout", err = dir / "stderr";
-    const std::string cmd = command + " > " + out.string() + " 2> " + err.string();
-    const int raw = std::system(cmd.c_str());
-    CliRun r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = Slurp(out);
-    r.err = Slurp(err);
-    return r;
+    return atmos_test::RunCapturing(command, dir / "stdout", dir / "stderr");
 }
 
 CliRun Atmos(const std::string& args, const fs::path& dir) {

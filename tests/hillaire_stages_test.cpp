@@ -15,16 +15,15 @@
 #include "models/hillaire.h"
 #include "models/hillaire_stages.h"
 #include "render/stages.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
 
-template <typename S>
-constexpr bool kIsDeviceStage = std::is_trivially_copyable<S>::value&& HasDeviceStage<S>::value;
-static_assert(kIsDeviceStage<HillaireTransmittanceStage>, "device stage");
-static_assert(kIsDeviceStage<HillaireMultipleScatteringStage>, "device stage");
-static_assert(kIsDeviceStage<HillaireSkyViewStage>, "device stage");
-static_assert(kIsDeviceStage<HillaireAerialPerspectiveStage>, "device stage");
+static_assert(
+    atmos_test::kAreDeviceStages<HillaireTransmittanceStage, HillaireMultipleScatteringStage,
+                                 HillaireSkyViewStage, HillaireAerialPerspectiveStage>,
+    "device stages");
 
 HillaireModel MakeModel() { return HillaireModel(HillaireOptions{}); }
 
@@ -51,11 +50,7 @@ TEST(HillaireStages, PrepareRenderAndSampleRunTheirTablesAsStages) {
 
     // A render inside the atmosphere builds its frame tables as stages...
     log.clear();
-    RenderRequest request;
-    request.view = GetView("ground-sunrise", atm);
-    request.width = 16;
-    request.height = 9;
-    request.show_progress = false;
+    RenderRequest request = atmos_test::QuietRequest(GetView("ground-sunrise", atm), 16, 9);
     Image image;
     model.Render(request, &image);
     // (the one launch log: the render's own launch follows its tables)

@@ -25,6 +25,7 @@
 #include "atmos/view.h"
 #include "base/interrupt.h"
 #include "render/render.h"
+#include "test_util.h"
 
 extern char** environ;
 
@@ -86,13 +87,6 @@ TEST(Interrupt, SighupIsHandledLikeSigterm) {
     EXPECT_STREQ(StopSignalName(SIGHUP), "SIGHUP");
 }
 
-std::string Slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
-
 // The reference at 1920x1080 (its order-1 table covers the whole image before
 // the first pass: 19 s before it acted on SIGINT): spawned with SIGINT
 // unblocked (CI may block it), signalled once it catches SIGINT, it stops
@@ -102,11 +96,7 @@ TEST(Interrupt, LargeReferenceRenderStopsInsideItsFirstStep) {
     if (!fs::exists("/proc/self/status")) GTEST_SKIP() << "no /proc";
     const char* env_cli = std::getenv("ATMOS_TEST_CLI");
     std::string cli = env_cli ? env_cli : ATMOS_CLI_PATH;
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    const fs::path dir = (env ? fs::path(env) : fs::temp_directory_path() / "atmos_test") /
-                         ("interrupt_" + std::to_string(getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = atmos_test::FreshTestTmpDir("interrupt_" + std::to_string(getpid()));
     std::vector<std::string> argv_text = {cli,
                                           "render",
                                           "--model",
@@ -118,47 +108,14 @@ TEST(Interrupt, LargeReferenceRenderStopsInsideItsFirstStep) {
                                           "-q",
                                           "-o",
                                           (dir / "i.exr").string()};
-    std::vector<char*> argv;
-    for (std::string& w : argv_text) argv.push_back(w.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t files;
-    posix_spawn_file_actions_init(&files);
-    posix_spawn_file_actions_addopen(&files, 1, "/dev/null", O_WRONLY, 0);
-    const std::string err_path = (dir / "err").string();
-    posix_spawn_file_actions_addopen(&files, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                     0644);
-    posix_spawnattr_t attr;
-    posix_spawnattr_init(&attr);
-    sigset_t none, stops;
-    sigemptyset(&none);
-    sigemptyset(&stops);
-    sigaddset(&stops, SIGINT);
-    sigaddset(&stops, SIGTERM);
-    sigaddset(&stops, SIGHUP);
-    posix_spawnattr_setsigmask(&attr, &none);
-    posix_spawnattr_setsigdefault(&attr, &stops);
-    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
     pid_t pid = 0;
-    const int spawned = posix_spawn(&pid, cli.c_str(), &files, &attr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&files);
-    posix_spawnattr_destroy(&attr);
+    const int spawned = atmos_test::SpawnWithDefaultSignals(argv_text, (dir / "err").string(),
+                                                            {SIGINT, SIGTERM, SIGHUP}, &pid);
     ASSERT_EQ(spawned, 0) << std::strerror(spawned);
-    const std::string status_path = "/proc/" + std::to_string(pid) + "/status";
-    bool catching = false, ended = false;
     int raw = 0;
-    while (!catching && !ended) {
-        std::ifstream status(status_path);
-        for (std::string line; std::getline(status, line);) {
-            if (line.rfind("SigCgt:", 0) == 0) {
-                catching = (std::stoull(line.substr(7), nullptr, 16) >> (SIGINT - 1)) & 1u;
-            }
-        }
-        if (!catching) {
-            ended = waitpid(pid, &raw, WNOHANG) == pid;
-            if (!ended) usleep(2000);
-        }
-    }
-    ASSERT_FALSE(ended) << "the render ended before it caught SIGINT: " << Slurp(dir / "err");
+    const bool ended = atmos_test::WaitUntilCatching(pid, SIGINT, 2000, &raw);
+    ASSERT_FALSE(ended) << "the render ended before it caught SIGINT: "
+                        << atmos_test::Slurp(dir / "err");
     const auto sent = std::chrono::steady_clock::now();
     ASSERT_EQ(kill(pid, SIGINT), 0);
     ASSERT_EQ(waitpid(pid, &raw, 0), pid);
@@ -167,7 +124,7 @@ TEST(Interrupt, LargeReferenceRenderStopsInsideItsFirstStep) {
     std::printf("SIGINT to exit at 1920x1080: %.2f s\n", latency);
     ASSERT_TRUE(WIFEXITED(raw)) << "ended by signal " << (WIFSIGNALED(raw) ? WTERMSIG(raw) : 0);
     EXPECT_EQ(WEXITSTATUS(raw), 2);
-    const std::string err = Slurp(dir / "err");
+    const std::string err = atmos_test::Slurp(dir / "err");
     EXPECT_NE(err.find("atmos: error: interrupted by SIGINT during reference: order 1"),
               std::string::npos)
         << err;

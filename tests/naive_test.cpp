@@ -14,6 +14,7 @@
 #include "base/parallel.h"
 #include "models/naive.h"
 #include "physics/transmittance.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -240,22 +241,9 @@ TEST(Render, AllTwelveViewsFiniteAndNonNegative) {
 TEST(Render, SameBytesForOneAndTwoThreads) {
     auto model = CreateModel("naive");
     model->Prepare(EarthAtmosphere());
-    RenderRequest request;
-    request.view = GetView("ground-sunrise", EarthAtmosphere());
-    request.width = 97;  // not a multiple of the tile size
-    request.height = 41;
-    request.show_progress = false;
-    Image one, two;
-    {
-        ThreadLimit limit(1);
-        model->Render(request, &one);
-    }
-    {
-        ThreadLimit limit(2);
-        model->Render(request, &two);
-    }
-    ASSERT_EQ(one.size(), two.size());
-    EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
+    RenderRequest request = atmos_test::QuietRequest(GetView("ground-sunrise", EarthAtmosphere()),
+                                                     97, 41);  // not a multiple of the tile size
+    atmos_test::ExpectSameImageForOneAndTwoThreads(*model, request);
 }
 
 TEST(Sample, MatchesEvaluatorAndContract) {

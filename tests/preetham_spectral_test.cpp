@@ -15,6 +15,7 @@
 #include "atmos/view.h"
 #include "harness/spectral_run.h"
 #include "models/preetham.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -196,11 +197,7 @@ TEST(PreethamSpectral, SpectralRenderMatchesTheRgbRender) {
     const std::vector<double> nm = ParseWavelengths("380:780:41");
     const auto prepare = [](const AtmosphereParameters& a, Model* m) { m->Prepare(a); };
     for (const char* view : {"ground-noon", "ground-sunrise", "ground-dawn"}) {
-        RenderRequest request;
-        request.view = GetView(view, EarthAtmosphere());
-        request.width = 48;
-        request.height = 27;
-        request.show_progress = false;
+        RenderRequest request = atmos_test::QuietRequest(GetView(view, EarthAtmosphere()), 48, 27);
         auto model = CreateModel("preetham");
         model->Prepare(EarthAtmosphere());
         Image rgb;

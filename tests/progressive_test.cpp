@@ -18,10 +18,12 @@
 #include "atmos/atmosphere.h"
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "base/fnv1a.h"
 #include "base/progress.h"
 #include "base/rng.h"
 #include "metrics/flip.h"
 #include "render/progressive.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -95,14 +97,32 @@ RenderRequest CoinRequest(int64_t spp, int64_t pass_spp) {
     return r;
 }
 
-std::filesystem::path TestDir(const char* name) {
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    const std::filesystem::path dir =
-        (env ? std::filesystem::path(env) : std::filesystem::temp_directory_path() / "atmos_test") /
-        name;
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    return dir;
+std::filesystem::path TestDir(const char* name) { return atmos_test::FreshTestTmpDir(name); }
+
+// Renders `request` with a checkpoint in the fresh folder `dir_name` and
+// returns the checkpoint file's path (request->checkpoint set).
+std::string WriteCoinCheckpoint(const CoinModel& model, const char* dir_name,
+                                RenderRequest* request, Image* image) {
+    request->checkpoint = (TestDir(dir_name) / "coin").string();
+    model.Render(*request, image);
+    return request->checkpoint + ".bin";
+}
+
+// Resumes request's checkpoint to 12 samples per pixel into *resumed and
+// returns how many passes that rendered.
+int ResumeToTwelveSamples(const CoinModel& model, RenderRequest* request, Image* resumed) {
+    request->monte_carlo.spp = 12;
+    request->resume = true;
+    const int before = model.passes_rendered;
+    model.Render(*request, resumed);
+    return model.passes_rendered - before;
+}
+
+// A checkpoint's bytes with the trailing FNV-1a checksum recomputed (after an edit).
+std::string ResumCheckpoint(std::string bytes) {
+    const uint64_t h = Fnv1a(bytes.data(), bytes.size() - 8);
+    std::memcpy(&bytes[bytes.size() - 8], &h, 8);
+    return bytes;
 }
 
 TEST(Progressive, PassesOfAnyMonteCarloModelWeightedByTheirCounts) {
@@ -169,12 +189,8 @@ TEST(Progressive, ResumesACheckpointOfAnyMonteCarloModel) {
     request.checkpoint = (dir / "coin").string();
     Image partial;
     model.Render(request, &partial);
-    request.monte_carlo.spp = 12;
-    request.resume = true;
     Image resumed;
-    const int before = model.passes_rendered;
-    model.Render(request, &resumed);
-    EXPECT_EQ(model.passes_rendered - before, 2);  // passes 3 and 4 only
+    EXPECT_EQ(ResumeToTwelveSamples(model, &request, &resumed), 2);  // passes 3 and 4 only
     ASSERT_EQ(resumed.size(), full.size());
     EXPECT_EQ(std::memcmp(resumed.data(), full.data(), full.size() * sizeof(float)), 0);
     // Another seed or pass size is another render: refused.
@@ -189,13 +205,8 @@ TEST(Progressive, ModelsThatAreNotMonteCarloFailClearly) {
     // The same class without the capability flag: the driver refuses it.
     const CoinModel flagless(false);
     Image image;
-    try {
-        flagless.Render(CoinRequest(4, 0), &image);
-        ADD_FAILURE() << "rendered a model that is not Monte Carlo";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("coin is not a Monte Carlo model"), std::string::npos)
-            << e.what();
-    }
+    EXPECT_ERROR_CONTAINS(flagless.Render(CoinRequest(4, 0), &image),
+                          "coin is not a Monte Carlo model");
     EXPECT_EQ(flagless.passes_rendered, 0);
     EXPECT_THROW(SampleMonteCarlo(flagless, {SampleQuery()}, MonteCarloSettings()), Error);
     // A registered deterministic model.
@@ -217,12 +228,7 @@ TEST(Progressive, SettingsAreValidatedWithOneClearError) {
           std::make_tuple(-3, 0, 0, "--spp must be at least 1"),
           std::make_tuple(1, -1, 0, "--seed must be in [0, 4294967295]"),
           std::make_tuple(1, 1, -1, "--pass-spp must be >= 0")}) {
-        try {
-            MakeMonteCarloSettings(spp, seed, pass);
-            ADD_FAILURE() << needle;
-        } catch (const Error& e) {
-            EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-        }
+        EXPECT_ERROR_CONTAINS(MakeMonteCarloSettings(spp, seed, pass), needle);
     }
     EXPECT_THROW(MakeMonteCarloSettings(1, 4294967296ll, 0), Error);
     // The driver itself refuses an empty render.
@@ -238,30 +244,13 @@ TEST(Progressive, SettingsAreValidatedWithOneClearError) {
 // error, never a wrong image.
 TEST(Progressive, ADamagedCheckpointIsOneClearError) {
     const CoinModel model(true);
-    const std::filesystem::path dir = TestDir("progressive_damaged");
     RenderRequest request = CoinRequest(6, 3);
-    request.checkpoint = (dir / "coin").string();
     Image image;
-    model.Render(request, &image);
-    const std::string path = request.checkpoint + ".bin";
-    std::string good;
-    {
-        std::ifstream f(path, std::ios::binary);
-        good.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-    }
+    const std::string path = WriteCoinCheckpoint(model, "progressive_damaged", &request, &image);
+    const std::string good = atmos_test::Slurp(path);
     ASSERT_GT(good.size(), 16u + 2 * 5 * 3 * 3 * sizeof(float));
     auto write = [&](const std::string& bytes) {
         std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
-    };
-    // Recomputes the trailing FNV-1a checksum after an edit.
-    auto resum = [](std::string bytes) {
-        uint64_t h = 14695981039346656037ull;
-        for (size_t i = 0; i + 8 < bytes.size(); ++i) {
-            h ^= static_cast<unsigned char>(bytes[i]);
-            h *= 1099511628211ull;
-        }
-        std::memcpy(&bytes[bytes.size() - 8], &h, 8);
-        return bytes;
     };
     request.monte_carlo.spp = 12;
     request.resume = true;
@@ -284,14 +273,14 @@ TEST(Progressive, ADamagedCheckpointIsOneClearError) {
     ASSERT_NE(at, std::string::npos);
     std::string counts = good;
     counts[at + 15] = '2';  // 2 samples in 2 passes of 3
-    expect_damaged(resum(counts), "counts disagree");
+    expect_damaged(ResumCheckpoint(counts), "counts disagree");
     std::string nan = good;
     const float q = std::numeric_limits<float>::quiet_NaN();
     std::memcpy(&nan[good.size() - 8 - 4], &q, 4);
-    expect_damaged(resum(nan), "not finite");
+    expect_damaged(ResumCheckpoint(nan), "not finite");
     std::string longer = good;
     longer.insert(good.size() - 8, 4, '\0');
-    expect_damaged(resum(longer), "wrong size");
+    expect_damaged(ResumCheckpoint(longer), "wrong size");
     // The intact checkpoint resumes to the uninterrupted image.
     write(good);
     Image resumed, full;
@@ -309,45 +298,24 @@ TEST(Progressive, ADamagedCheckpointIsOneClearError) {
 // a FIFO in its place is one clear error, never a block.
 TEST(Progressive, ACheckpointsSumsAreRangeChecked) {
     const CoinModel model(true);
-    const std::filesystem::path dir = TestDir("progressive_ranges");
     RenderRequest request = CoinRequest(6, 3);
-    request.checkpoint = (dir / "coin").string();
     Image image;
-    model.Render(request, &image);
-    const std::string path = request.checkpoint + ".bin";
-    std::string good;
-    {
-        std::ifstream f(path, std::ios::binary);
-        good.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-    }
+    const std::string path = WriteCoinCheckpoint(model, "progressive_ranges", &request, &image);
+    const std::string good = atmos_test::Slurp(path);
     uint64_t header_size = 0;
     std::memcpy(&header_size, good.data() + 8, 8);
     const size_t sums = 16 + header_size, n = 5 * 3 * 3;
-    auto resum = [](std::string bytes) {
-        uint64_t h = 14695981039346656037ull;
-        for (size_t i = 0; i + 8 < bytes.size(); ++i) {
-            h ^= static_cast<unsigned char>(bytes[i]);
-            h *= 1099511628211ull;
-        }
-        std::memcpy(&bytes[bytes.size() - 8], &h, 8);
-        return bytes;
-    };
     auto with_float = [&](size_t index, float value) {
         std::string bytes = good;
         std::memcpy(&bytes[sums + 4 * index], &value, 4);
-        return resum(bytes);
+        return ResumCheckpoint(bytes);
     };
     request.monte_carlo.spp = 12;
     request.resume = true;
     auto expect_refused = [&](const std::string& bytes, const char* why) {
         std::filesystem::remove_all(path);
         std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
-        try {
-            model.Render(request, &image);
-            ADD_FAILURE() << "resumed from a checkpoint with " << why;
-        } catch (const Error& e) {
-            EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
-        }
+        EXPECT_ERROR_CONTAINS(model.Render(request, &image), why);
     };
     float sum0 = 0.0f, sq0 = 0.0f;
     std::memcpy(&sum0, &good[sums], 4);
@@ -364,25 +332,15 @@ TEST(Progressive, ACheckpointsSumsAreRangeChecked) {
     const size_t at = seed.find("\"seed\":11");
     ASSERT_NE(at, std::string::npos);
     seed[at + 8] = '2';
-    expect_refused(resum(seed), "different render");
+    expect_refused(ResumCheckpoint(seed), "different render");
     EXPECT_NE(good.find("\"estimator_version\""), std::string::npos);
     // A directory, a FIFO: one clear error at once.
     std::filesystem::remove(path);
     std::filesystem::create_directories(path);
-    try {
-        model.Render(request, &image);
-        ADD_FAILURE() << "resumed from a directory";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
-    }
+    EXPECT_ERROR_CONTAINS(model.Render(request, &image), "is a directory");
     std::filesystem::remove(path);
     ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
-    try {
-        model.Render(request, &image);
-        ADD_FAILURE() << "resumed from a FIFO";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
-    }
+    EXPECT_ERROR_CONTAINS(model.Render(request, &image), "not a regular file");
     std::filesystem::remove(path);
     // The intact checkpoint still resumes.
     std::ofstream(path, std::ios::binary) << good;
@@ -434,12 +392,8 @@ TEST(Progressive, RendersToANoiseTargetOrTheCap) {
     request.monte_carlo.spp = 6;
     request.checkpoint = (dir / "coin").string();
     model.Render(request, &quick);
-    request.monte_carlo.spp = 12;
-    request.resume = true;
     Image resumed;
-    const int before = model.passes_rendered;
-    model.Render(request, &resumed);
-    EXPECT_EQ(model.passes_rendered - before, 2);
+    EXPECT_EQ(ResumeToTwelveSamples(model, &request, &resumed), 2);
     EXPECT_EQ(report.samples, 12);
     EXPECT_EQ(std::memcmp(resumed.data(), plain.data(), plain.size() * sizeof(float)), 0);
     // A noise target out of range is one clear error.

@@ -24,6 +24,7 @@
 #include "models/reference.h"
 #include "physics/transmittance.h"
 #include "render/render.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -397,26 +398,11 @@ TEST(ReferenceDeterminism, SameImageForAnyThreadCountAndAfterResume) {
     request.width = 24;
     request.height = 13;
     request.show_progress = false;
-    Image one, two;
-    {
-        ThreadLimit limit(1);
-        model->Render(request, &one);
-    }
-    {
-        ThreadLimit limit(2);
-        model->Render(request, &two);
-    }
-    ASSERT_EQ(one.size(), two.size());
-    EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(float)), 0);
+    const Image one = atmos_test::ExpectSameImageForOneAndTwoThreads(*model, request);
 
     // Interrupted after 4 of 8 spp (a render with --spp 4 and the same pass
     // size writes the checkpoint), then resumed to 8: identical to the full run.
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    const std::filesystem::path dir =
-        (env ? std::filesystem::path(env) : std::filesystem::temp_directory_path() / "atmos_test") /
-        "reference_resume";
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
+    const std::filesystem::path dir = atmos_test::FreshTestTmpDir("reference_resume");
     RenderRequest checkpointed = request;
     checkpointed.checkpoint = (dir / "ckpt").string();
     checkpointed.monte_carlo.spp = 4;
@@ -450,11 +436,7 @@ TEST(Reference, FiniteNonNegativeInEveryView) {
     const AtmosphereParameters atm = LoadAtmosphere("earth-bruneton");  // albedo 0.1: bounces
     model->Prepare(atm);
     for (const View& view : StandardViews(atm)) {
-        RenderRequest request;
-        request.view = view;
-        request.width = 16;
-        request.height = 9;
-        request.show_progress = false;
+        RenderRequest request = atmos_test::QuietRequest(view, 16, 9);
         request.monte_carlo.spp = 2;
         Image image;
         model->Render(request, &image);
@@ -949,11 +931,7 @@ TEST(ReferenceHybrid, Order1CachedPerRequestEqualsTheUncachedEstimate) {
     model->Prepare(atm);
     for (const char* name : {"ground-noon", "ground-dawn", "ground-noon"}) {
         SCOPED_TRACE(name);
-        RenderRequest request;
-        request.view = GetView(name, atm);
-        request.width = 12;
-        request.height = 7;
-        request.show_progress = false;
+        RenderRequest request = atmos_test::QuietRequest(GetView(name, atm), 12, 7);
         request.monte_carlo.spp = 8;
         request.monte_carlo.pass_spp = 4;
         request.monte_carlo.seed = 3;
@@ -1084,11 +1062,7 @@ TEST(ReferenceShipped, FreshRenderAgreesWithEachShippedImageWithinItsNoise) {
         double same = 0.0, other = 0.0;
         for (const AtmosphereParameters* a : {&atm, &changed}) {
             model->Prepare(*a);
-            RenderRequest request;
-            request.view = GetView(name, *a);
-            request.width = width;
-            request.height = height;
-            request.show_progress = false;
+            RenderRequest request = atmos_test::QuietRequest(GetView(name, *a), width, height);
             request.monte_carlo.spp = 64;
             request.monte_carlo.pass_spp = 8;
             request.monte_carlo.seed = 777;

@@ -13,24 +13,14 @@
 #include <sstream>
 #include <string>
 
+#include "test_util.h"
+
 namespace {
 
 namespace fs = std::filesystem;
+using atmos_test::Slurp;
 
-fs::path TempDir() {
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
-    dir /= "rgba_tables";
-    fs::create_directories(dir);
-    return dir;
-}
-
-std::string Read(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
+fs::path TempDir() { return atmos_test::TestTmpDir("rgba_tables"); }
 
 uint32_t U32(const std::string& b, size_t at) {
     uint32_t v = 0;
@@ -115,10 +105,11 @@ TEST(RgbaTables, Ktx2AndBlobsReadBack) {
                                 " --layout rgba -o " + dir.string();
         ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
         std::string file = model;
-        const nlohmann::json raw = nlohmann::json::parse(Read(dir / (file + ".json"))).at("raw");
-        const nlohmann::json rgba = nlohmann::json::parse(Read(dir / "tables_rgba.json"));
-        const std::string f32 = Read(dir / "tables.f32"), f16 = Read(dir / "tables.f16");
-        const std::string r32 = Read(dir / "tables_rgba.f32"), r16 = Read(dir / "tables_rgba.f16");
+        const nlohmann::json raw = nlohmann::json::parse(Slurp(dir / (file + ".json"))).at("raw");
+        const nlohmann::json rgba = nlohmann::json::parse(Slurp(dir / "tables_rgba.json"));
+        const std::string f32 = Slurp(dir / "tables.f32"), f16 = Slurp(dir / "tables.f16");
+        const std::string r32 = Slurp(dir / "tables_rgba.f32"),
+                          r16 = Slurp(dir / "tables_rgba.f16");
         EXPECT_EQ(rgba.at("float32").at("bytes").get<size_t>(), r32.size());
         EXPECT_EQ(rgba.at("float16").at("bytes").get<size_t>(), r16.size());
         ASSERT_EQ(raw.at("tables").size(), rgba.at("tables").size());
@@ -132,7 +123,7 @@ TEST(RgbaTables, Ktx2AndBlobsReadBack) {
             EXPECT_EQ(o16 % 256, 0u);
             for (int half = 0; half < 2; ++half) {
                 const Ktx2 k = ReadKtx2(
-                    Read(dir / q.at(half ? "ktx2_rgba16f" : "ktx2_rgba32f").get<std::string>()));
+                    Slurp(dir / q.at(half ? "ktx2_rgba16f" : "ktx2_rgba32f").get<std::string>()));
                 EXPECT_EQ(k.vk_format, half ? 97u : 109u) << name;
                 EXPECT_EQ(k.type_size, half ? 2u : 4u);
                 EXPECT_EQ(k.width, w);

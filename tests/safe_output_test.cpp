@@ -25,6 +25,7 @@
 #include <thread>
 
 #include "io/output_path.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
@@ -35,38 +36,18 @@ std::string Cli() {
     return env ? env : ATMOS_CLI_PATH;
 }
 
+using atmos_test::Slurp;
+using Outcome = atmos_test::CommandOutcome;
+
 fs::path Dir(const std::string& name) {
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
-    dir /= "safe_output_" + name + "_" + std::to_string(getpid());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
+    return atmos_test::FreshTestTmpDir("safe_output_" + name + "_" + std::to_string(getpid()));
 }
-
-std::string Slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
-
-struct Outcome {
-    int status = -1;
-    std::string out, err;
-};
 
 // `sh -c SCRIPT` in `dir` with $ATMOS the executable; stdout and stderr kept.
 Outcome Shell(const fs::path& dir, const std::string& script) {
-    const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-    const std::string cmd = "cd '" + dir.string() + "' && ATMOS='" + Cli() + "' sh -c '" + script +
-                            "' > '" + out.string() + "' 2> '" + err.string() + "'";
-    const int raw = std::system(cmd.c_str());
-    Outcome r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = Slurp(out);
-    r.err = Slurp(err);
-    return r;
+    return atmos_test::RunCapturing(
+        "cd '" + dir.string() + "' && ATMOS='" + Cli() + "' sh -c '" + script + "'",
+        dir / "stdout.txt", dir / "stderr.txt");
 }
 
 const char kQueries[] = "altitude_m,mu,mu_s,azimuth_deg\n0,0.5,0.5,0\n";

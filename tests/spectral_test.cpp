@@ -17,6 +17,7 @@
 #include "atmos/view.h"
 #include "harness/kider.h"
 #include "harness/spectral_run.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -97,11 +98,7 @@ TEST(Spectral, ThreeWavelengthRunEqualsTheRgbRunBitForBit) {
         SCOPED_TRACE(name);
         auto model = CreateModel(name);
         model->Prepare(rgb);
-        RenderRequest request;
-        request.view = GetView("ground-sunrise", rgb);
-        request.width = 24;
-        request.height = 14;
-        request.show_progress = false;
+        RenderRequest request = atmos_test::QuietRequest(GetView("ground-sunrise", rgb), 24, 14);
         Image image;
         model->Render(request, &image);
         const SpectralImage s =

@@ -7,19 +7,13 @@
 
 #include "base/texture.h"
 #include "render/stages.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
 
 // out(x, y) = 2 * in(x, y) + out(x, y) + x: reads an input, accumulates into the output.
-struct ScaleAddStage {
-    TableView in;
-    TableOut out;
-    template <typename V>
-    void VisitTables(V& v) {
-        v(in);
-        v(out);
-    }
+struct ScaleAddStage : atmos_test::InOutStage {
     ATMOS_HD void operator()(int64_t i) const {
         const int x = static_cast<int>(i % out.width);
         const int y = static_cast<int>(i / out.width);

@@ -17,27 +17,16 @@
 #include "studies/compare.h"
 #include "studies/spectral_sample.h"
 #include "studies/validate.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace atmos {
 namespace {
 
-fs::path TestDir(const std::string& name) {
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
-    dir /= "studies_" + name;
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+using atmos_test::Slurp;
 
-std::string Slurp(const fs::path& path) {
-    std::ifstream f(path);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
+fs::path TestDir(const std::string& name) { return atmos_test::FreshTestTmpDir("studies_" + name); }
 
 fs::path KiderTestData() { return fs::path(ATMOS_SOURCE_DIR) / "tests" / "data" / "kider-2013"; }
 

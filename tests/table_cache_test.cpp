@@ -23,6 +23,7 @@
 #include "atmos/model.h"
 #include "atmos/view.h"
 #include "harness/table_cache.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
@@ -58,11 +59,7 @@ TableCacheSettings Scratch(const std::string& name) {
 std::vector<float> RenderBits(const Model& model) {
     std::vector<float> all;
     for (const char* view : {"ground-sunrise", "orbit-noon"}) {
-        RenderRequest request;
-        request.view = GetView(view, EarthAtmosphere());
-        request.width = 16;
-        request.height = 9;
-        request.show_progress = false;
+        RenderRequest request = atmos_test::QuietRequest(GetView(view, EarthAtmosphere()), 16, 9);
         Image image;
         model.Render(request, &image);
         all.insert(all.end(), image.data(), image.data() + image.size());

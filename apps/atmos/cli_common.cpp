@@ -15,17 +15,23 @@ bool g_strict = false;
 
 bool StrictRequested() { return g_strict; }
 
+// --atmosphere, --set and --threads (every command that runs a model).
+void AddAtmosphereOptions(CLI::App* cmd, std::string* atmosphere, std::vector<std::string>* sets,
+                          int* threads) {
+    cmd->add_option("--atmosphere,-a", *atmosphere, "preset name or JSON file")
+        ->capture_default_str();
+    cmd->add_option("--set", *sets, "override one atmosphere field: FIELD=VALUE (repeatable)")
+        ->allow_extra_args(false);
+    cmd->add_option("--threads", *threads, "worker threads (0: all cores)")
+        ->check(CLI::Range(0, 4096));  // (NonNegativeNumber printed a 309-digit bound)
+}
+
 void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
     cmd->add_option("--model,-m", o->model,
                     "the model and its options: NAME[:OPTION=VALUE...], e.g. bruneton:orders=2 "
                     "(`atmos list NAME` prints a model's options and defaults)")
         ->capture_default_str();
-    cmd->add_option("--atmosphere,-a", o->atmosphere, "preset name or JSON file")
-        ->capture_default_str();
-    cmd->add_option("--set", o->sets, "override one atmosphere field: FIELD=VALUE (repeatable)")
-        ->allow_extra_args(false);
-    cmd->add_option("--threads", o->threads, "worker threads (0: all cores)")
-        ->check(CLI::Range(0, 4096));  // (NonNegativeNumber printed a 309-digit bound)
+    AddAtmosphereOptions(cmd, &o->atmosphere, &o->sets, &o->threads);
     cmd->add_flag("--quiet,-q", o->quiet, "no progress bar or timing lines");
     cmd->add_flag("--strict", g_strict,
                   "fail (exit 2) when the output guard had to replace a NaN, infinite or "
@@ -40,12 +46,7 @@ void AddCommonOptions(CLI::App* cmd, CommonOptions* o) {
 }
 
 void AddStudyFlags(CLI::App* cmd, StudyFlags* flags, bool backend, const char* quiet_help) {
-    cmd->add_option("--atmosphere,-a", flags->atmosphere, "preset name or JSON file")
-        ->capture_default_str();
-    cmd->add_option("--set", flags->sets, "override one atmosphere field: FIELD=VALUE (repeatable)")
-        ->allow_extra_args(false);
-    cmd->add_option("--threads", flags->threads, "worker threads (0: all cores)")
-        ->check(CLI::Range(0, 4096));  // (NonNegativeNumber printed a 309-digit bound)
+    AddAtmosphereOptions(cmd, &flags->atmosphere, &flags->sets, &flags->threads);
     if (quiet_help) cmd->add_flag("--quiet,-q", flags->quiet, quiet_help);
     if (backend) AddBackendOption(cmd, &flags->backend);
 }

@@ -9,6 +9,8 @@
 
 #include <signal.h>
 
+#include "base/non_copyable.h"
+
 namespace atmos {
 
 // The signal recorded by the active StopSignalScope, or 0.
@@ -16,12 +18,10 @@ int StopSignalReceived();
 // "SIGINT", "SIGTERM" or "SIGHUP".
 const char* StopSignalName(int signal_number);
 
-class StopSignalScope {
+class StopSignalScope : private NonCopyable {
   public:
     explicit StopSignalScope(bool active);
     ~StopSignalScope();
-    StopSignalScope(const StopSignalScope&) = delete;
-    StopSignalScope& operator=(const StopSignalScope&) = delete;
     int Received() const { return active_ ? StopSignalReceived() : 0; }
 
   private:

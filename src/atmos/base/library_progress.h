@@ -4,17 +4,17 @@
 // bar itself still prints only on a terminal and after about a second.
 #pragma once
 
+#include "base/non_copyable.h"
+
 namespace atmos {
 
 bool LibraryProgressEnabled();
 
 // Sets the switch for its lifetime, then restores the previous value.
-class LibraryProgressScope {
+class LibraryProgressScope : private NonCopyable {
   public:
     explicit LibraryProgressScope(bool enabled);
     ~LibraryProgressScope();
-    LibraryProgressScope(const LibraryProgressScope&) = delete;
-    LibraryProgressScope& operator=(const LibraryProgressScope&) = delete;
 
   private:
     bool previous_;

@@ -16,16 +16,16 @@
 #include <string>
 #include <vector>
 
+#include "base/non_copyable.h"
+
 namespace atmos {
 
 // Limits the worker threads used by ParallelFor for the lifetime of the
 // returned guard (0: all cores). Nested guards: the innermost wins.
-class ThreadLimit {
+class ThreadLimit : private NonCopyable {
   public:
     explicit ThreadLimit(int threads);
     ~ThreadLimit();
-    ThreadLimit(const ThreadLimit&) = delete;
-    ThreadLimit& operator=(const ThreadLimit&) = delete;
 
   private:
     void* control_ = nullptr;
@@ -62,12 +62,10 @@ void CheckBackendAvailable(Backend backend);
 // Selects the backend of the per-pixel loops for the lifetime of the guard
 // (checked with CheckBackendAvailable first). Process-wide; nested guards:
 // the innermost wins.
-class BackendScope {
+class BackendScope : private NonCopyable {
   public:
     explicit BackendScope(Backend backend);
     ~BackendScope();
-    BackendScope(const BackendScope&) = delete;
-    BackendScope& operator=(const BackendScope&) = delete;
 
   private:
     Backend previous_;

@@ -13,14 +13,14 @@
 #include <mutex>
 #include <string>
 
+#include "base/non_copyable.h"
+
 namespace atmos {
 
-class Progress {
+class Progress : private NonCopyable {
   public:
     Progress(std::string label, int64_t total, bool enabled);
     ~Progress();
-    Progress(const Progress&) = delete;
-    Progress& operator=(const Progress&) = delete;
 
     void Add(int64_t done);
     // True when the bar can ever print (enabled and stderr is a terminal).

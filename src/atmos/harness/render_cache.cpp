@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "atmos/error.h"
+#include "base/fnv1a.h"
 #include "io/output_path.h"
 
 namespace fs = std::filesystem;
@@ -18,15 +19,7 @@ std::string BuildIdentity() {
     static const std::string identity = [] {
         std::ifstream exe("/proc/self/exe", std::ios::binary);
         if (!exe) return std::string("unknown");
-        std::uint64_t h = 14695981039346656037ull;
-        char buffer[1 << 16];
-        while (exe.read(buffer, sizeof(buffer)) || exe.gcount() > 0) {
-            const std::streamsize n = exe.gcount();
-            for (std::streamsize i = 0; i < n; ++i) {
-                h ^= static_cast<unsigned char>(buffer[i]);
-                h *= 1099511628211ull;
-            }
-        }
+        const std::uint64_t h = Fnv1aStream(exe);
         char text[17];
         std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(h));
         return std::string(text);
@@ -53,14 +46,7 @@ std::string RenderKeyText(const RenderKey& key) {
     return os.str();
 }
 
-std::uint64_t Fnv1a64(const std::string& text) {
-    std::uint64_t h = 14695981039346656037ull;
-    for (unsigned char c : text) {
-        h ^= c;
-        h *= 1099511628211ull;
-    }
-    return h;
-}
+std::uint64_t Fnv1a64(const std::string& text) { return Fnv1a(text.data(), text.size()); }
 
 std::map<std::string, std::string> ResolvedModelOptions(
     const std::string& model, const std::map<std::string, std::string>& given) {

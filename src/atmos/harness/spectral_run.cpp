@@ -26,15 +26,25 @@ size_t StoredChannels(const std::array<size_t, 3>& batch) {
     return count;
 }
 
-std::unique_ptr<Model> PrepareBatch(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
-                                    const double l[3], const PrepareFunction& prepare,
-                                    AtmosphereParameters* batch) {
-    *batch = atmosphere.AtWavelengths(l[0], l[1], l[2]);
-    std::unique_ptr<Model> model = CreateModel(spec);
-    RequireSpectralModel(model->Info());
-    model->SetSpectralBatch(atmosphere, l);
-    prepare(*batch, model.get());
-    return model;
+// Calls each(b, indices, stored, model, batch) for every batch b of three of
+// `nm` (SpectralBatches: their indices in `nm`, StoredChannels), with the model
+// of `spec` given the batch's wavelengths and prepared (`prepare`) for
+// `batch`, the atmosphere at them.
+template <typename F>
+void ForEachPreparedBatch(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
+                          const std::vector<double>& nm, BatchLayout layout,
+                          const PrepareFunction& prepare, F each) {
+    const std::vector<std::array<size_t, 3>> batches = SpectralBatches(nm.size(), layout);
+    for (size_t b = 0; b < batches.size(); ++b) {
+        const double l[3] = {nm[batches[b][0]], nm[batches[b][1]], nm[batches[b][2]]};
+        const size_t stored = StoredChannels(batches[b]);
+        AtmosphereParameters batch = atmosphere.AtWavelengths(l[0], l[1], l[2]);
+        std::unique_ptr<Model> model = CreateModel(spec);
+        RequireSpectralModel(model->Info());
+        model->SetSpectralBatch(atmosphere, l);
+        prepare(batch, model.get());
+        each(b, batches[b], stored, *model, batch);
+    }
 }
 
 }  // namespace
@@ -104,40 +114,39 @@ std::vector<SpectralImage> RenderSpectralRequests(
     }
     if (render_seconds) render_seconds->assign(requests.size(), 0.0);
     if (reports) reports->assign(requests.size(), MonteCarloReport());
-    const std::vector<std::array<size_t, 3>> batches = SpectralBatches(n, batching.layout);
-    for (size_t b = 0; b < batches.size(); ++b) {
-        const double l[3] = {nm[batches[b][0]], nm[batches[b][1]], nm[batches[b][2]]};
-        const size_t stored = StoredChannels(batches[b]);
-        AtmosphereParameters batch;
-        std::unique_ptr<Model> model = PrepareBatch(spec, atmosphere, l, prepare, &batch);
-        for (size_t v = 0; v < requests.size(); ++v) {
-            RenderRequest r = requests[v];
-            r.checkpoint.clear();
-            r.resume = false;
-            r.variance = nullptr;
-            r.monte_carlo.seed = BatchSeed(r.monte_carlo.seed, b, batching.seeds);
-            MonteCarloReport report;
-            r.report = &report;
-            Image image;
-            const auto start = std::chrono::steady_clock::now();
-            model->Render(r, &image);
-            if (render_seconds) {
-                (*render_seconds)[v] +=
-                    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            }
-            if (reports) {
-                MonteCarloReport& total = (*reports)[v];
-                total.samples += report.samples;
-                total.noise = std::max(total.noise, report.noise);
-            }
-            const size_t pixels = static_cast<size_t>(r.width) * r.height;
-            for (size_t p = 0; p < pixels; ++p) {
-                for (size_t c = 0; c < stored; ++c) {
-                    out[v].values[p * n + batches[b][c]] = image.data()[p * 3 + c];
+    ForEachPreparedBatch(
+        spec, atmosphere, nm, batching.layout, prepare,
+        [&](size_t b, const std::array<size_t, 3>& indices, size_t stored, Model& model,
+            const AtmosphereParameters&) {
+            for (size_t v = 0; v < requests.size(); ++v) {
+                RenderRequest r = requests[v];
+                r.checkpoint.clear();
+                r.resume = false;
+                r.variance = nullptr;
+                r.monte_carlo.seed = BatchSeed(r.monte_carlo.seed, b, batching.seeds);
+                MonteCarloReport report;
+                r.report = &report;
+                Image image;
+                const auto start = std::chrono::steady_clock::now();
+                model.Render(r, &image);
+                if (render_seconds) {
+                    (*render_seconds)[v] +=
+                        std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+                            .count();
+                }
+                if (reports) {
+                    MonteCarloReport& total = (*reports)[v];
+                    total.samples += report.samples;
+                    total.noise = std::max(total.noise, report.noise);
+                }
+                const size_t pixels = static_cast<size_t>(r.width) * r.height;
+                for (size_t p = 0; p < pixels; ++p) {
+                    for (size_t c = 0; c < stored; ++c) {
+                        out[v].values[p * n + indices[c]] = image.data()[p * 3 + c];
+                    }
                 }
             }
-        }
-    }
+        });
     return out;
 }
 
@@ -165,25 +174,23 @@ std::vector<double> SampleSpectral(const ModelSpec& spec, const SpectralAtmosphe
                                    const PrepareFunction& prepare, SpectralBatching batching) {
     const size_t n = nm.size();
     std::vector<double> out(queries.size() * n, 0.0);
-    const std::vector<std::array<size_t, 3>> batches = SpectralBatches(n, batching.layout);
-    for (size_t b = 0; b < batches.size(); ++b) {
-        const double l[3] = {nm[batches[b][0]], nm[batches[b][1]], nm[batches[b][2]]};
-        const size_t stored = StoredChannels(batches[b]);
-        AtmosphereParameters batch;
-        std::unique_ptr<Model> model = PrepareBatch(spec, atmosphere, l, prepare, &batch);
-        MonteCarloSettings mc = monte_carlo;
-        mc.seed = BatchSeed(mc.seed, b, batching.seeds);
-        const std::vector<SampleAnswer> answers = model->Info().capabilities.stochastic
-                                                      ? SampleMonteCarlo(*model, queries, mc)
-                                                      : model->Sample(queries);
-        for (size_t q = 0; q < queries.size(); ++q) {
-            for (size_t c = 0; c < stored; ++c) {
-                const int ci = static_cast<int>(c);
-                out[q * n + batches[b][c]] =
-                    static_cast<double>(answers[q].radiance[ci]) * batch.solar_irradiance[ci];
+    ForEachPreparedBatch(
+        spec, atmosphere, nm, batching.layout, prepare,
+        [&](size_t b, const std::array<size_t, 3>& indices, size_t stored, Model& model,
+            const AtmosphereParameters& batch) {
+            MonteCarloSettings mc = monte_carlo;
+            mc.seed = BatchSeed(mc.seed, b, batching.seeds);
+            const std::vector<SampleAnswer> answers = model.Info().capabilities.stochastic
+                                                          ? SampleMonteCarlo(model, queries, mc)
+                                                          : model.Sample(queries);
+            for (size_t q = 0; q < queries.size(); ++q) {
+                for (size_t c = 0; c < stored; ++c) {
+                    const int ci = static_cast<int>(c);
+                    out[q * n + indices[c]] =
+                        static_cast<double>(answers[q].radiance[ci]) * batch.solar_irradiance[ci];
+                }
             }
-        }
-    }
+        });
     return out;
 }
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "atmos/error.h"
+#include "base/fnv1a.h"
 
 namespace fs = std::filesystem;
 
@@ -26,22 +27,6 @@ namespace {
 
 constexpr const char* kManifest = "manifest.json";
 
-uint64_t HashStream(std::istream& in, int64_t* bytes) {
-    uint64_t h = 14695981039346656037ull;
-    int64_t n_total = 0;
-    char buffer[1 << 16];
-    while (in.read(buffer, sizeof(buffer)) || in.gcount() > 0) {
-        const std::streamsize n = in.gcount();
-        for (std::streamsize i = 0; i < n; ++i) {
-            h ^= static_cast<unsigned char>(buffer[i]);
-            h *= 1099511628211ull;
-        }
-        n_total += n;
-    }
-    if (bytes) *bytes = n_total;
-    return h;
-}
-
 std::string Hex(uint64_t h) {
     char text[17];
     std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(h));
@@ -50,14 +35,14 @@ std::string Hex(uint64_t h) {
 
 uint64_t HashText(const std::string& text) {
     std::istringstream in(text);
-    return HashStream(in, nullptr);
+    return Fnv1aStream(in, nullptr);
 }
 
 // Size and checksum of a file; false when it cannot be read.
 bool HashFile(const fs::path& path, int64_t* bytes, std::string* checksum) {
     std::ifstream in(path, std::ios::binary);
     if (!in) return false;
-    *checksum = Hex(HashStream(in, bytes));
+    *checksum = Hex(Fnv1aStream(in, bytes));
     return true;
 }
 
@@ -152,7 +137,7 @@ std::string CodeIdentity() {
         }
         std::ifstream in(path, std::ios::binary);
         if (!in) return std::string("unknown");
-        return Hex(HashStream(in, nullptr));
+        return Hex(Fnv1aStream(in, nullptr));
     }();
     return identity;
 }

@@ -768,12 +768,7 @@ std::string AtmosphereToJson(const AtmosphereParameters& a) {
 }
 
 std::vector<std::string> AtmospherePresetNames() {
-    std::vector<std::string> names;
-    for (int i = 0; i < detail::kEmbeddedPresetCount; ++i) {
-        names.emplace_back(detail::kEmbeddedPresets[i].name);
-    }
-    std::sort(names.begin(), names.end());
-    return names;
+    return detail::SortedNames(detail::kEmbeddedPresets, detail::kEmbeddedPresetCount);
 }
 
 namespace {

@@ -14,20 +14,24 @@
 
 #include "atmos/error.h"
 #include "io/output_path.h"
+#include "io/text_files.h"
 
 namespace atmos {
+
+int RunShellCommand(const std::string& command, std::string* output) {
+    output->clear();
+    std::FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+    if (!pipe) return -1;
+    char buffer[4096];
+    size_t n;
+    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) output->append(buffer, n);
+    const int status = pclose(pipe);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
 
 namespace engine_shaders {
 
 namespace fs = std::filesystem;
-
-std::string ReadText(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) Fail("cannot read '", path.string(), "'");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 // The frame's uniform block (std140, set 0, binding 0), shared by every stage.
 // hillaire's aerial-perspective camera (the WebGL2 source's loose atmos_ap_*
@@ -176,21 +180,9 @@ std::string Quote(const fs::path& p) {
     return s + "'";
 }
 
-// Runs a shell command; returns its exit status and puts stdout+stderr in *output.
-int Run(const std::string& command, std::string* output) {
-    output->clear();
-    std::FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-    if (!pipe) return -1;
-    char buffer[4096];
-    size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) output->append(buffer, n);
-    const int status = pclose(pipe);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 bool ToolFound(const char* tool) {
     std::string out;
-    return Run(std::string("command -v ") + tool, &out) == 0;
+    return RunShellCommand(std::string("command -v ") + tool, &out) == 0;
 }
 
 std::string FirstLines(const std::string& text) {
@@ -216,9 +208,9 @@ void WriteEngineShaders(const std::string& dir_text, const std::string& model_na
         if (c == '-') c = '_';
     }
     const fs::path shaders = dir / "shaders";
-    const std::string constants = ReadText(shaders / (file + "_constants.glsl"));
-    const std::string common = ReadText(shaders / "common.glsl");
-    const std::string model = ReadText(shaders / (file + ".glsl"));
+    const std::string constants = ReadWholeFile(shaders / (file + "_constants.glsl"));
+    const std::string common = ReadWholeFile(shaders / "common.glsl");
+    const std::string model = ReadWholeFile(shaders / (file + ".glsl"));
 
     std::vector<Binding> bindings = {{0, "AtmosFrame", "uniform block (std140)"}};
     int next_binding = 1;
@@ -307,18 +299,19 @@ void WriteEngineShaders(const std::string& dir_text, const std::string& model_na
         stem[stem.rfind('.')] = '_';
         const fs::path spv = spirv / (stem + ".spv");
         std::string out;
-        if (Run("glslangValidator -V --target-env vulkan1.0 -S " + s.stage + " -o " + Quote(spv) +
-                    " " + Quote(vulkan / s.name),
-                &out) != 0) {
+        if (RunShellCommand("glslangValidator -V --target-env vulkan1.0 -S " + s.stage + " -o " +
+                                Quote(spv) + " " + Quote(vulkan / s.name),
+                            &out) != 0) {
             Fail("bake: glslangValidator -V refused ", (vulkan / s.name).string(), ": ",
                  FirstLines(out));
         }
-        if (Run("spirv-cross " + Quote(spv) + " --hlsl --shader-model 50 --output " +
-                    Quote(hlsl / (stem + ".hlsl")),
-                &out) != 0) {
+        if (RunShellCommand("spirv-cross " + Quote(spv) + " --hlsl --shader-model 50 --output " +
+                                Quote(hlsl / (stem + ".hlsl")),
+                            &out) != 0) {
             Fail("bake: spirv-cross --hlsl failed on ", spv.string(), ": ", FirstLines(out));
         }
-        if (Run("spirv-cross " + Quote(spv) + " --msl --output " + Quote(msl / (stem + ".metal")),
+        if (RunShellCommand(
+                "spirv-cross " + Quote(spv) + " --msl --output " + Quote(msl / (stem + ".metal")),
                 &out) != 0) {
             Fail("bake: spirv-cross --msl failed on ", spv.string(), ": ", FirstLines(out));
         }

@@ -19,6 +19,10 @@ namespace atmos {
 // tools refuse is an atmos::Error with their message.
 void WriteEngineShaders(const std::string& dir, const std::string& model_name, bool quiet);
 
+// Runs a shell command; returns its exit status (-1: it did not exit) and
+// puts its stdout and stderr in *output.
+int RunShellCommand(const std::string& command, std::string* output);
+
 // Both glslangValidator and spirv-cross are on the PATH.
 bool EngineShaderToolsFound();
 

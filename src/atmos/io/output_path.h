@@ -27,6 +27,8 @@
 #include <sstream>
 #include <string>
 
+#include "base/non_copyable.h"
+
 namespace atmos {
 
 // The file `path` can be created or replaced (or is a stream, above): its
@@ -69,12 +71,10 @@ int CreateExclusiveFile(const std::string& directory, const std::string& prefix,
 // object's life, so two runs on one checkpoint fail fast: the second throws
 // atmos::Error saying another run holds it. The lock file is removed on
 // release. An empty path locks nothing.
-class FileLock {
+class FileLock : private NonCopyable {
   public:
     explicit FileLock(const std::string& path);
     ~FileLock();
-    FileLock(const FileLock&) = delete;
-    FileLock& operator=(const FileLock&) = delete;
 
   private:
     std::string lock_path_;
@@ -88,12 +88,10 @@ class FileLock {
 // where NAME is not there yet, one rename; the previous directory is then
 // removed. A failure or an interruption before Commit() leaves NAME as it was
 // (never a mix of two bakes); the destructor removes an uncommitted sibling.
-class StagedDirectory {
+class StagedDirectory : private NonCopyable {
   public:
     explicit StagedDirectory(const std::string& final_path);
     ~StagedDirectory();
-    StagedDirectory(const StagedDirectory&) = delete;
-    StagedDirectory& operator=(const StagedDirectory&) = delete;
     const std::string& path() const { return staging_; }
     void Commit();
     // Before the work: CheckOutputDirectory, and an existing `path` holds only

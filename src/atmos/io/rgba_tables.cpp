@@ -11,20 +11,13 @@
 
 #include "atmos/error.h"
 #include "io/output_path.h"
+#include "io/text_files.h"
 
 namespace atmos {
 
 namespace rgba_tables {
 
 namespace fs = std::filesystem;
-
-std::string ReadBytes(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) Fail("cannot read '", path.string(), "'");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 void PutU32(std::string* out, uint32_t v) {
     for (int i = 0; i < 4; ++i) out->push_back(static_cast<char>((v >> (8 * i)) & 0xFF));
@@ -144,10 +137,10 @@ std::string Ktx2File(int width, int height, int depth, int bytes_per_channel,
 void WriteRgbaTables(const std::string& dir_text, const std::string& model_name) {
     using namespace rgba_tables;
     const fs::path dir(dir_text);
-    const nlohmann::json bake = nlohmann::json::parse(ReadBytes(dir / (model_name + ".json")));
+    const nlohmann::json bake = nlohmann::json::parse(ReadWholeFile(dir / (model_name + ".json")));
     const nlohmann::json& raw = bake.at("raw");
-    const std::string f32 = ReadBytes(dir / raw.at("float32").at("file").get<std::string>());
-    const std::string f16 = ReadBytes(dir / raw.at("float16").at("file").get<std::string>());
+    const std::string f32 = ReadWholeFile(dir / raw.at("float32").at("file").get<std::string>());
+    const std::string f16 = ReadWholeFile(dir / raw.at("float16").at("file").get<std::string>());
     float one_f = 1.0f;
     std::string one32(4, '\0');
     std::memcpy(one32.data(), &one_f, 4);  // little-endian hosts (as the blobs)

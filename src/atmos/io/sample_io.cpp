@@ -49,19 +49,10 @@ std::vector<SampleQuery> ParseQueriesCsv(std::string_view text) {
     int line_number = 0;
     bool header = false;
     static const char* const kColumns[4] = {"altitude_m", "mu", "mu_s", "azimuth_deg"};
-    while (!text.empty()) {
-        const size_t eol = text.find('\n');
-        std::string_view line = text.substr(0, eol);
-        text = eol == std::string_view::npos ? std::string_view() : text.substr(eol + 1);
-        ++line_number;
-        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-        if (line.find_first_not_of(" \t") == std::string_view::npos) continue;
+    std::string_view line;
+    while (NextCsvLine(&text, &line, &line_number)) {
         if (!header) {
-            std::string compact;
-            for (char c : line) {
-                if (c != ' ' && c != '\t') compact += c;
-            }
-            if (compact != kQueryHeader) {
+            if (!IsCsvHeader(line, kQueryHeader)) {
                 Fail("line ", line_number, ": expected the header '", kQueryHeader, "', got '",
                      std::string(line), "'");
             }

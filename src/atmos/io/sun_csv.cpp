@@ -28,18 +28,11 @@ std::vector<Row> ParseRows(std::string_view text, double height_m) {
     std::vector<Row> rows;
     bool header = false;
     int row_number = 0;
-    while (!text.empty()) {
-        const size_t eol = text.find('\n');
-        std::string_view line = text.substr(0, eol);
-        text = eol == std::string_view::npos ? std::string_view() : text.substr(eol + 1);
-        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-        if (line.find_first_not_of(" \t") == std::string_view::npos) continue;
+    int lines = 0;
+    std::string_view line;
+    while (NextCsvLine(&text, &line, &lines)) {
         if (!header) {
-            std::string compact;
-            for (char c : line) {
-                if (c != ' ' && c != '\t') compact += c;
-            }
-            if (compact != kHeader) {
+            if (!IsCsvHeader(line, kHeader)) {
                 Fail("expected the header '", kHeader, "' on the first line, got '",
                      std::string(line), "'");
             }

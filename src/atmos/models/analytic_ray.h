@@ -38,6 +38,27 @@ ATMOS_HD inline bool BeginAnalyticRay(const Optics& optics, const Vec3d& camera,
     return false;
 }
 
+// The evaluator of the analytic single-scattering models (CRTP: no virtual
+// call): Evaluate clips the view ray (BeginAnalyticRay) and hands the segment
+// inside the atmosphere to Derived's
+//   ATMOS_HD void Integrate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+//                           bool want_ground, const AtmosphereSegment& seg,
+//                           RayResult* out) const;
+template <typename Derived, typename Optics>
+struct AnalyticEvaluator {
+    Optics optics;
+
+    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                                bool want_ground) const {
+        RayResult out;
+        AtmosphereSegment seg;
+        if (BeginAnalyticRay(optics, camera, dir, sun, want_ground, &out, &seg)) {
+            static_cast<const Derived&>(*this).Integrate(camera, dir, sun, want_ground, seg, &out);
+        }
+        return out;
+    }
+};
+
 // The end of the single-scattering sum: the sky from the attenuation-weighted
 // Rayleigh and Mie optical lengths (sum_r, sum_m) and the phase functions at
 // nu = dir.sun, the view's transmittance t_view, and the lit ground where the

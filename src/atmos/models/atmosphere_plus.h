@@ -123,6 +123,23 @@ struct AplusThickNodes {
     }
 };
 
+// The view ray of a table texel (h, mu, mu_s), sun at azimuth 0: its start at
+// altitude h, the view and sun directions, and its segment inside the
+// atmosphere (Boody's Atmosphere Plus notes 2.1).
+struct AplusTexelRay {
+    Vec3d p0, view, sun;
+    AtmosphereSegment seg;
+};
+ATMOS_HD inline AplusTexelRay AplusTexelRayOf(const AtmosphereParameters& atm, double h, double mu,
+                                              double mu_s) {
+    AplusTexelRay t;
+    t.p0 = Vec3d(0.0, 0.0, atm.bottom_radius + h);
+    t.view = Vec3d(SafeSqrt(1.0 - mu * mu), 0.0, mu);
+    t.sun = Vec3d(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
+    t.seg = ClipToAtmosphere(t.p0, t.view, atm.bottom_radius, atm.top_radius);
+    return t;
+}
+
 // Boody's Atmosphere Plus notes sections 1.10, 2.1, 2.3: the factored single scattering I1 for an
 // observer at altitude h looking along mu with the sun at mu_s (azimuth 0),
 // trapezoidal rule with `steps` intervals along the view segment and
@@ -130,10 +147,7 @@ struct AplusThickNodes {
 ATMOS_HD inline AplusValue AplusSingleScattering(const AtmosphereParameters& atm, double h,
                                                  double mu, double mu_s, int steps, int sun_steps) {
     AplusValue out;
-    const Vec3d p0(0.0, 0.0, atm.bottom_radius + h);
-    const Vec3d view(SafeSqrt(1.0 - mu * mu), 0.0, mu);
-    const Vec3d sun(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
-    const AtmosphereSegment seg = ClipToAtmosphere(p0, view, atm.bottom_radius, atm.top_radius);
+    const auto [p0, view, sun, seg] = AplusTexelRayOf(atm, h, mu, mu_s);
     if (!seg.inside) return out;
     const double ds = (seg.t_end - seg.t_start) / steps;
     // Optically thick steps: the exponential-linear rule on the same nodes and

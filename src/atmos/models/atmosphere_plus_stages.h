@@ -61,10 +61,7 @@ ATMOS_HD inline AplusValue AplusOrderFromGather(const TableView& gather,
                                                 const AplusSettings& s, double h, double mu,
                                                 double mu_s) {
     AplusValue out;
-    const Vec3d p0(0.0, 0.0, atm.bottom_radius + h);
-    const Vec3d view(SafeSqrt(1.0 - mu * mu), 0.0, mu);
-    const Vec3d sun(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
-    const AtmosphereSegment seg = ClipToAtmosphere(p0, view, atm.bottom_radius, atm.top_radius);
+    const auto [p0, view, sun, seg] = AplusTexelRayOf(atm, h, mu, mu_s);
     if (!seg.inside) return out;
     const int steps = s.transmittance_steps;
     const double ds = (seg.t_end - seg.t_start) / steps;

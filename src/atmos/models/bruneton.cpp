@@ -11,6 +11,7 @@
 #include "io/output_path.h"
 #include "io/raw_tables.h"
 #include "io/table_io.h"
+#include "io/text_files.h"
 #include "models/option_json.h"
 
 namespace atmos {
@@ -171,14 +172,6 @@ std::string GlslConstants(const AtmosphereParameters& a, const BrunetonConfig& c
     return s.str();
 }
 
-std::string ReadText(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) Fail("cannot read '", path, "'");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 }  // namespace
 
 namespace {
@@ -274,7 +267,7 @@ void BrunetonModel::LoadBaked(const std::string& directory,
     const std::string path = (dir / kBakeJson).string();
     nlohmann::ordered_json j;
     try {
-        j = nlohmann::ordered_json::parse(ReadText(path));
+        j = nlohmann::ordered_json::parse(ReadWholeFile(path));
     } catch (const nlohmann::json::exception& e) {
         Fail("'", path, "' is not valid JSON: ", e.what());
     }

@@ -35,6 +35,15 @@ void LogRows(const char* name, int64_t rows, Clock::time_point start) {
     LogStage({name, rows, "cpu", ms, ms});
 }
 
+// Runs row(r) for every row r of the scattering table (ParallelFor) and logs
+// the run under `name` (LogRows).
+template <typename F>
+void ForEachRow(const char* name, const BrunetonConfig& c, F row) {
+    const Clock::time_point start = Clock::now();
+    ParallelFor(RowCount(c), 1, row);
+    LogRows(name, RowCount(c), start);
+}
+
 int64_t TexelCount(const Table& t) {
     return static_cast<int64_t>(t.width()) * t.height() * t.depth();
 }
@@ -134,8 +143,7 @@ void ComputeBrunetonSingleScatteringRowsScalar(const BrunetonLut& lut, Table* ra
     const int width = c.scattering_nu * c.scattering_mu_s;
     rayleigh->Resize(width, c.scattering_mu, c.scattering_r, 3);
     mie->Resize(width, c.scattering_mu, c.scattering_r, 3);
-    const Clock::time_point start = Clock::now();
-    ParallelFor(RowCount(c), 1, [&](int64_t row) {
+    ForEachRow("bruneton single scattering (scalar rows)", c, [&](int64_t row) {
         const RowSamples<BrunetonSingleSample> rs = SingleScatteringRow(lut, row);
         const int y = rs.y, z = rs.z;
         const double r = rs.r, dx = rs.dx;
@@ -155,7 +163,6 @@ void ComputeBrunetonSingleScatteringRowsScalar(const BrunetonLut& lut, Table* ra
             mie->Set(x, y, z, BrunetonVec4(sum_m * beta_m));
         }
     });
-    LogRows("bruneton single scattering (scalar rows)", RowCount(c), start);
 }
 
 // Per row (r, mu): the samples' transmittance from the camera and the (mu, r)
@@ -167,8 +174,7 @@ void ComputeBrunetonMultipleScatteringRowsScalar(const BrunetonLut& lut, const T
     const int width = c.scattering_nu * c.scattering_mu_s;
     out->Resize(width, c.scattering_mu, c.scattering_r, 3);
     const BrunetonFastLookup fast(lut, density);
-    const Clock::time_point start = Clock::now();
-    ParallelFor(RowCount(c), 1, [&](int64_t row) {
+    ForEachRow("bruneton multiple scattering (scalar rows)", c, [&](int64_t row) {
         const RowSamples<BrunetonMultipleSample> rs = MultipleScatteringRow(lut, fast, row);
         const int y = rs.y, z = rs.z;
         const double r = rs.r;
@@ -204,7 +210,6 @@ void ComputeBrunetonMultipleScatteringRowsScalar(const BrunetonLut& lut, const T
             out->Set(x, y, z, BrunetonVec4(sum[static_cast<size_t>(x)]));
         }
     });
-    LogRows("bruneton multiple scattering (scalar rows)", RowCount(c), start);
 }
 
 // ---- vectorised rows (issue 19 item 2) ----
@@ -250,8 +255,7 @@ void ComputeBrunetonSingleScatteringRows(const BrunetonLut& lut, Table* rayleigh
     const float* const tdata = tt.data;
     const int t_width = tt.width;
     const double top2 = kc.top * kc.top;
-    const Clock::time_point start = Clock::now();
-    ParallelFor(RowCount(c), 1, [&](int64_t row) {
+    ForEachRow("bruneton single scattering (rows)", c, [&](int64_t row) {
         const RowSamples<BrunetonSingleSample> rs = SingleScatteringRow(lut, row);
         const int y = rs.y, z = rs.z;
         const double r = rs.r, dx = rs.dx;
@@ -324,7 +328,6 @@ void ComputeBrunetonSingleScatteringRows(const BrunetonLut& lut, Table* rayleigh
             mie->Set(x, y, z, BrunetonVec4(Rgb(sm0[x], sm1[x], sm2[x]) * beta_m));
         }
     });
-    LogRows("bruneton single scattering (rows)", RowCount(c), start);
 }
 
 // Multiple scattering: per sample, the density's two (mu, r) row pairs are
@@ -350,8 +353,7 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
     const double inv_d_range = 1.0 / kc.mu_s_d_range;
     const double inv_big_a = 1.0 / kc.mu_s_big_a;
     const double inv_nu = 1.0 / nu_size;
-    const Clock::time_point start = Clock::now();
-    ParallelFor(RowCount(c), 1, [&](int64_t row) {
+    ForEachRow("bruneton multiple scattering (rows)", c, [&](int64_t row) {
         const RowSamples<BrunetonMultipleSample> rs = MultipleScatteringRow(lut, fast, row);
         const int y = rs.y, z = rs.z;
         const double r = rs.r;
@@ -413,7 +415,6 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
         }
         for (int x = 0; x < width; ++x) out->Set(x, y, z, BrunetonVec4(Rgb(s0[x], s1[x], s2[x])));
     });
-    LogRows("bruneton multiple scattering (rows)", RowCount(c), start);
 }
 
 void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,

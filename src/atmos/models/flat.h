@@ -58,10 +58,7 @@ struct FlatOptics {
     // Optical lengths of the segment [t0, t1] of the ray origin + t dir.
     ATMOS_HD MediaLengths SegmentLengths(const Vec3d& origin, const Vec3d& dir, double t0,
                                          double t1) const {
-        const Vec3d p = origin + dir * t0;
-        const double r = Length(p);
-        const double mu = ClampCosine(Dot(p, dir) / r);
-        const double d = Max(t1 - t0, 0.0);
+        const auto [r, mu, d] = RaySegmentStartOf(origin, dir, t0, t1);
         MediaLengths l;
         l.rayleigh = SegmentFromToInfinity(FlatUpLength{m.rayleigh_H, m.bottom}, r, mu, d);
         l.mie = SegmentFromToInfinity(FlatUpLength{m.mie_H, m.bottom}, r, mu, d);
@@ -86,15 +83,11 @@ struct FlatOptics {
     }
 };
 
-struct FlatEvaluator {
-    FlatOptics optics;
-
-    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
-                                bool want_ground) const {
+struct FlatEvaluator : AnalyticEvaluator<FlatEvaluator, FlatOptics> {
+    // The segment inside the atmosphere (AnalyticEvaluator::Evaluate).
+    ATMOS_HD void Integrate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                            bool want_ground, const AtmosphereSegment& seg, RayResult* out) const {
         const AnalyticMedia& m = optics.m;
-        RayResult out;
-        AtmosphereSegment seg;
-        if (!BeginAnalyticRay(optics, camera, dir, sun, want_ground, &out, &seg)) return out;
         const MediaLengths l = optics.SegmentLengths(camera, dir, seg.t_start, seg.t_end);
         const Vec3d tau = m.Extinction(l.rayleigh, l.mie, l.ozone);
         const Vec3d p0 = camera + dir * seg.t_start;
@@ -107,10 +100,9 @@ struct FlatEvaluator {
                            m.mie_scattering * (l.mie * m.MiePhaseAt(nu))) *
                           e;
         const Vec3d t_view = Exp(-tau);
-        out.sky = Rgb(sky);
-        out.transmittance = Rgb(t_view);
-        if (want_ground && seg.hits_ground) out.ground = AnalyticGround(optics, p1, sun, t_view);
-        return out;
+        out->sky = Rgb(sky);
+        out->transmittance = Rgb(t_view);
+        if (want_ground && seg.hits_ground) out->ground = AnalyticGround(optics, p1, sun, t_view);
     }
 };
 

@@ -113,6 +113,8 @@
 #include "physics/geometry.h"
 #include "physics/phase.h"
 
+#include "base/non_copyable.h"
+
 namespace atmos {
 
 // Table sizes (paper section 5 and the issue).
@@ -487,11 +489,9 @@ struct HillaireEvaluator {
 
 // The per-frame tables for one camera and sun. Not copyable: the evaluator
 // references the tables.
-class HillaireFrame {
+class HillaireFrame : private NonCopyable {
   public:
     HillaireFrame() = default;
-    HillaireFrame(const HillaireFrame&) = delete;
-    HillaireFrame& operator=(const HillaireFrame&) = delete;
     // The evaluator with this frame's tables attached.
     HillaireEvaluator Evaluator() const;
     HillaireEvaluator base;

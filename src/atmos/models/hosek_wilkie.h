@@ -56,6 +56,7 @@
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "models/evaluator_model.h"
+#include "models/fitted_sky.h"
 #include "physics/geometry.h"
 
 namespace atmos {
@@ -121,52 +122,23 @@ struct HosekWilkieSunTerms {
     HosekWilkieConfig k[kHosekWilkieMaxSources];
 };
 
-struct HosekWilkieEvaluator {
-    double bottom = 6360e3, top = 6460e3;
+struct HosekWilkieEvaluator : FittedSkyEvaluator<HosekWilkieEvaluator, HosekWilkieSunTerms> {
     int sources = 3;
     // Per source: the control points blended in turbidity and albedo.
     double ctrl[kHosekWilkieMaxSources][6][10] = {};
     // Output channel c = max(sum_s mix[c][s] L_s, 0).
     double mix[3][kHosekWilkieMaxSources] = {};
-    // The sun terms of the view set by PrepareView (as preetham's).
-    bool has_view = false;
-    Vec3d view_camera, view_sun;
-    HosekWilkieSunTerms view;
 
     ATMOS_HD HosekWilkieSunTerms SunTerms(const Vec3d& up, const Vec3d& sun) const {
         HosekWilkieSunTerms t;
-        double cos_s = Dot(sun, up);
-        t.s = sun;
-        if (cos_s < 0.0) {
-            const Vec3d horizontal = sun - up * cos_s;
-            const double len = Length(horizontal);
-            t.s = len > 1e-9 ? horizontal / len : Normalize(Cross(up, Vec3d(1.0, 0.0, 0.0)));
-            cos_s = 0.0;
-        }
+        double cos_s;
+        t.s = SunRaisedToHorizon(up, sun, &cos_s);
         const double elevation = 0.5 * kPi - acos(Clamp(cos_s, -1.0, 1.0));
         for (int i = 0; i < sources; ++i) t.k[i] = HosekWilkieCook(ctrl[i], elevation);
         return t;
     }
-    ATMOS_HD void PrepareView(const Vec3d& camera, const Vec3d& sun) {
-        view = SunTerms(Normalize(camera), sun);
-        view_camera = camera;
-        view_sun = sun;
-        has_view = true;
-    }
-
-    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
-                                bool) const {
-        RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, bottom, top);
-        out.hits_ground = seg.hits_ground;
-        if (seg.hits_ground) out.transmittance = Rgb(0.0f);
-        if (!seg.inside || seg.hits_ground) return out;
-        const Vec3d up = Normalize(camera);
-        const bool same_view = has_view && camera.x == view_camera.x && camera.y == view_camera.y &&
-                               camera.z == view_camera.z && sun.x == view_sun.x &&
-                               sun.y == view_sun.y && sun.z == view_sun.z;
-        const HosekWilkieSunTerms st = same_view ? view : SunTerms(up, sun);
+    // The sky toward `dir` (models/fitted_sky.h).
+    ATMOS_HD Rgb Sky(const HosekWilkieSunTerms& st, const Vec3d& up, const Vec3d& dir) const {
         const double cos_theta = Max(Dot(dir, up), 0.0);
         const double gamma = acos(Clamp(Dot(dir, st.s), -1.0, 1.0));
         double l[kHosekWilkieMaxSources];
@@ -177,8 +149,7 @@ struct HosekWilkieEvaluator {
             for (int i = 0; i < sources; ++i) v += mix[j][i] * l[i];
             c[j] = static_cast<float>(Max(v, 0.0));
         }
-        out.sky = Rgb(c[0], c[1], c[2]);
-        return out;
+        return Rgb(c[0], c[1], c[2]);
     }
 };
 

@@ -89,13 +89,9 @@ struct OneilOptics {
                m.mie_extinction * ToInfinity(mie, r, mu_s);
     }
     ATMOS_HD Vec3d SegmentDepth(const Vec3d& origin, const Vec3d& dir, double t0, double t1) const {
-        const Vec3d p = origin + dir * t0;
-        const double r = Length(p);
-        const double mu = ClampCosine(Dot(p, dir) / r);
-        const double d = Max(t1 - t0, 0.0);
-        return m.rayleigh_scattering *
-                   SegmentFromToInfinity(OneilLength{rayleigh, m.bottom}, r, mu, d) +
-               m.mie_extinction * SegmentFromToInfinity(OneilLength{mie, m.bottom}, r, mu, d);
+        return RayleighMieSegmentDepth(m.rayleigh_scattering, OneilLength{rayleigh, m.bottom},
+                                       m.mie_extinction, OneilLength{mie, m.bottom}, origin, dir,
+                                       t0, t1);
     }
 };
 
@@ -107,8 +103,7 @@ struct OneilRayStart {
     double f_tangent = 0.0;  // f(r0 sqrt(1 - mu0^2), 0), only for mu0 < 0
 };
 
-struct OneilEvaluator {
-    OneilOptics optics;
+struct OneilEvaluator : AnalyticEvaluator<OneilEvaluator, OneilOptics> {
     int steps = 5;
 
     // f(r, mu) = L exp(-h/H) scale(mu) of one medium with exp(-h/H) given
@@ -147,12 +142,9 @@ struct OneilEvaluator {
     // SegmentDepth recomputes it from the segment's start: the same radius up
     // to rounding, results within ~1e-13 relative; tests/oneil_test.cpp holds
     // this loop against the generic one).
-    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
-                                bool want_ground) const {
+    ATMOS_HD void Integrate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                            bool want_ground, const AtmosphereSegment& seg, RayResult* out) const {
         const AnalyticMedia& m = optics.m;
-        RayResult out;
-        AtmosphereSegment seg;
-        if (!BeginAnalyticRay(optics, camera, dir, sun, want_ground, &out, &seg)) return out;
         const Vec3d p0 = camera + dir * seg.t_start;
         const double r0 = Length(p0);
         const double mu0 = ClampCosine(Dot(p0, dir) / r0);
@@ -187,8 +179,7 @@ struct OneilEvaluator {
             sum_m += attenuation * (rho_m * ds);
         }
         FinishAnalyticRay(optics, camera, dir, sun, seg, want_ground, dir_sun, sum_r, sum_m,
-                          Exp(-optics.SegmentDepth(camera, dir, seg.t_start, seg.t_end)), &out);
-        return out;
+                          Exp(-optics.SegmentDepth(camera, dir, seg.t_start, seg.t_end)), out);
     }
 };
 

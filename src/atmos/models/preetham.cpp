@@ -83,10 +83,7 @@ ModelInfo PreethamModel::StaticInfo() {
     info.summary =
         "fitted Perez sky (xyY from turbidity) for a ground viewer; luminance / 128 klx as "
         "radiance per unit irradiance";
-    info.capabilities.transmittance = false;
-    info.capabilities.space_views = false;
-    info.capabilities.sun_below_horizon = false;
-    info.capabilities.multiple_scattering = true;  // fitted to a full simulation
+    info.capabilities = FittedSkyCapabilities();
     info.options = OptionRows().Specs();
     info.thesis_name = "Preetham, Shirley and Smits";
     info.thesis_lines = 58;

@@ -50,6 +50,7 @@
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "models/evaluator_model.h"
+#include "models/fitted_sky.h"
 #include "physics/geometry.h"
 
 namespace atmos {
@@ -117,16 +118,9 @@ struct PreethamSunTerms {
     double fY0 = 1.0, fx0 = 1.0, fy0 = 1.0;  // F(0, theta_s) of Y, x, y
 };
 
-struct PreethamEvaluator {
-    double bottom = 6360e3, top = 6460e3;
+struct PreethamEvaluator : FittedSkyEvaluator<PreethamEvaluator, PreethamSunTerms> {
     double turbidity = 2.5;
     PerezCoefficients kY{}, kx{}, ky{};
-    // The sun terms of the view set by PrepareView (render/render.h calls it
-    // once per frame): a ray from that camera toward that sun reuses them; any
-    // other (a sample query) computes its own, by the same code.
-    bool has_view = false;
-    Vec3d view_camera, view_sun;
-    PreethamSunTerms view;
     // Spectral batch (PreethamModel::SetSpectralBatch, then Prepare): the
     // channels are three wavelengths of the daylight spectrum, not sRGB.
     bool spectral = false;
@@ -136,15 +130,8 @@ struct PreethamEvaluator {
 
     ATMOS_HD PreethamSunTerms SunTerms(const Vec3d& up, const Vec3d& sun) const {
         PreethamSunTerms t;
-        // Sun raised to the horizon when below it.
-        double cos_s = Dot(sun, up);
-        t.s = sun;
-        if (cos_s < 0.0) {
-            const Vec3d horizontal = sun - up * cos_s;
-            const double len = Length(horizontal);
-            t.s = len > 1e-9 ? horizontal / len : Normalize(Cross(up, Vec3d(1.0, 0.0, 0.0)));
-            cos_s = 0.0;
-        }
+        double cos_s;
+        t.s = SunRaisedToHorizon(up, sun, &cos_s);
         t.theta_s = acos(Clamp(cos_s, -1.0, 1.0));
         t.Yz = ZenithLuminance(t.theta_s);
         t.xz = ZenithChromaticity(t.theta_s, true);
@@ -154,30 +141,11 @@ struct PreethamEvaluator {
         t.fy0 = PerezF(ky, 1.0, t.theta_s);
         return t;
     }
-    ATMOS_HD void PrepareView(const Vec3d& camera, const Vec3d& sun) {
-        view = SunTerms(Normalize(camera), sun);
-        view_camera = camera;
-        view_sun = sun;
-        has_view = true;
-    }
-
-    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
-                                bool) const {
-        RayResult out;
-        out.transmittance = Rgb(1.0f);
-        const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, bottom, top);
-        out.hits_ground = seg.hits_ground;
-        if (seg.hits_ground) out.transmittance = Rgb(0.0f);
-        if (!seg.inside || seg.hits_ground) return out;
-        const Vec3d up = Normalize(camera);
-        const bool same_view = has_view && camera.x == view_camera.x && camera.y == view_camera.y &&
-                               camera.z == view_camera.z && sun.x == view_sun.x &&
-                               sun.y == view_sun.y && sun.z == view_sun.z;
-        const PreethamSunTerms st = same_view ? view : SunTerms(up, sun);
+    // The sky toward `dir` (models/fitted_sky.h).
+    ATMOS_HD Rgb Sky(const PreethamSunTerms& st, const Vec3d& up, const Vec3d& dir) const {
         double L = 0.0, x = 0.0, y = 0.0;
         SkyXyY(st, up, dir, &L, &x, &y);
-        out.sky = spectral ? DaylightChannels(L, x, y) : XyYToSrgb(L, x, y);
-        return out;
+        return spectral ? DaylightChannels(L, x, y) : XyYToSrgb(L, x, y);
     }
 
     // The sky's luminance per unit solar illuminance L (Y[kcd/m^2] 1000 /

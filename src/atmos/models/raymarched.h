@@ -28,16 +28,13 @@
 
 namespace atmos {
 
-struct RaymarchedEvaluator {
-    FlatOptics optics;
+struct RaymarchedEvaluator : AnalyticEvaluator<RaymarchedEvaluator, FlatOptics> {
     int steps = 5;
 
-    ATMOS_HD RayResult Evaluate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
-                                bool want_ground) const {
+    // The segment inside the atmosphere (AnalyticEvaluator::Evaluate).
+    ATMOS_HD void Integrate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                            bool want_ground, const AtmosphereSegment& seg, RayResult* out) const {
         const AnalyticMedia& m = optics.m;
-        RayResult out;
-        AtmosphereSegment seg;
-        if (!BeginAnalyticRay(optics, camera, dir, sun, want_ground, &out, &seg)) return out;
         const double dt = (seg.t_end - seg.t_start) / steps;
         Vec3d tau_view;  // camera to the start of the current part
         Vec3d light_a = optics.LightDepth(camera + dir * seg.t_start, sun);
@@ -55,8 +52,7 @@ struct RaymarchedEvaluator {
             light_a = light_b;
         }
         FinishAnalyticRay(optics, camera, dir, sun, seg, want_ground, Dot(dir, sun), sum_r, sum_m,
-                          Exp(-tau_view), &out);
-        return out;
+                          Exp(-tau_view), out);
     }
 };
 

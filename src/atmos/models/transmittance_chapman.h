@@ -28,14 +28,9 @@ struct ChapmanTransmittanceOptics {
     double unit = kChapmanSeedUnit;  // `--chapman-unit`: see ChapmanLengthToInfinity
 
     ATMOS_HD Vec3d SegmentDepth(const Vec3d& origin, const Vec3d& dir, double t0, double t1) const {
-        const Vec3d p = origin + dir * t0;
-        const double r = Length(p);
-        const double mu = ClampCosine(Dot(p, dir) / r);
-        const double d = Max(t1 - t0, 0.0);
-        return m.rayleigh_scattering *
-                   SegmentFromToInfinity(ChapmanUpLength{m.rayleigh_H, m.bottom, unit}, r, mu, d) +
-               m.mie_extinction *
-                   SegmentFromToInfinity(ChapmanUpLength{m.mie_H, m.bottom, unit}, r, mu, d);
+        return RayleighMieSegmentDepth(
+            m.rayleigh_scattering, ChapmanUpLength{m.rayleigh_H, m.bottom, unit}, m.mie_extinction,
+            ChapmanUpLength{m.mie_H, m.bottom, unit}, origin, dir, t0, t1);
     }
 };
 

@@ -56,4 +56,17 @@ class TransmittanceModel : public SimpleEvaluatorModel<Derived, TransmittanceEva
     }
 };
 
+// A transmittance model without options whose optics are Optics{Make(atmosphere)}
+// (transmittance-erfc, -flat, -polynomial). Derived implements `static ModelInfo
+// StaticInfo()` and a constructor from NoOptions.
+template <typename Derived, typename Optics, typename Data,
+          Data (*Make)(const AtmosphereParameters&)>
+class OptionlessTransmittanceModel : public TransmittanceModel<Derived, Optics> {
+  public:
+    static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
+    Optics MakeOptics(const AtmosphereParameters& atmosphere) const {
+        return Optics{Make(atmosphere)};
+    }
+};
+
 }  // namespace atmos

@@ -14,6 +14,7 @@
 
 #include "models/transmittance_common.h"
 #include "physics/analytic_media.h"
+#include "physics/analytic_optical_depth.h"
 
 namespace atmos {
 
@@ -21,24 +22,18 @@ struct ErfcTransmittanceOptics {
     AnalyticMedia m;
 
     ATMOS_HD Vec3d SegmentDepth(const Vec3d& origin, const Vec3d& dir, double t0, double t1) const {
-        const Vec3d p = origin + dir * t0;
-        const double r = Length(p);
-        const double mu = ClampCosine(Dot(p, dir) / r);
-        const double d = Max(t1 - t0, 0.0);
+        const auto [r, mu, d] = RaySegmentStartOf(origin, dir, t0, t1);
         return m.rayleigh_scattering * ErfcSegmentLength(r, mu, d, m.rayleigh_H, m.bottom) +
                m.mie_extinction * ErfcSegmentLength(r, mu, d, m.mie_H, m.bottom);
     }
 };
 
 class TransmittanceErfcModel
-    : public TransmittanceModel<TransmittanceErfcModel, ErfcTransmittanceOptics> {
+    : public OptionlessTransmittanceModel<TransmittanceErfcModel, ErfcTransmittanceOptics,
+                                          AnalyticMedia, MakeAnalyticMedia> {
   public:
-    static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit TransmittanceErfcModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
     static ModelInfo StaticInfo();
-    ErfcTransmittanceOptics MakeOptics(const AtmosphereParameters& atmosphere) const {
-        return ErfcTransmittanceOptics{MakeAnalyticMedia(atmosphere)};
-    }
 };
 
 }  // namespace atmos

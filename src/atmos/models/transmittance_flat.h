@@ -17,14 +17,12 @@
 
 namespace atmos {
 
-class TransmittanceFlatModel : public TransmittanceModel<TransmittanceFlatModel, FlatOptics> {
+class TransmittanceFlatModel
+    : public OptionlessTransmittanceModel<TransmittanceFlatModel, FlatOptics, AnalyticMedia,
+                                          MakeAnalyticMedia> {
   public:
-    static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit TransmittanceFlatModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
     static ModelInfo StaticInfo();
-    FlatOptics MakeOptics(const AtmosphereParameters& atmosphere) const {
-        return FlatOptics{MakeAnalyticMedia(atmosphere)};
-    }
 };
 
 }  // namespace atmos

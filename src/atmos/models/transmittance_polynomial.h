@@ -50,10 +50,7 @@ struct PolynomialTransmittanceOptics {
     PolynomialSigmoid fit;
 
     ATMOS_HD Vec3d SegmentDepth(const Vec3d& origin, const Vec3d& dir, double t0, double t1) const {
-        const Vec3d p = origin + dir * t0;
-        const double r = Length(p);
-        const double mu = ClampCosine(Dot(p, dir) / r);
-        const double d = Max(t1 - t0, 0.0);
+        const auto [r, mu, d] = RaySegmentStartOf(origin, dir, t0, t1);
         Vec3d tau;
         for (int c = 0; c < 3; ++c)
             tau[c] = SegmentFromToInfinity(PolynomialChannel{&fit, c}, r, mu, d);
@@ -62,19 +59,19 @@ struct PolynomialTransmittanceOptics {
 };
 
 // Least-squares fit of Eq. 42 to the atmosphere's numerical transmittance
-// (host). `rms_error` (optional) receives the fit's RMS error in T.
-PolynomialSigmoid FitPolynomialSigmoid(const AtmosphereParameters& atmosphere,
-                                       double* rms_error = nullptr);
+// (host). `rms_error` receives the fit's RMS error in T.
+PolynomialSigmoid FitPolynomialSigmoid(const AtmosphereParameters& atmosphere, double* rms_error);
+inline PolynomialSigmoid FitPolynomialSigmoid(const AtmosphereParameters& atmosphere) {
+    return FitPolynomialSigmoid(atmosphere, nullptr);
+}
 
 class TransmittancePolynomialModel
-    : public TransmittanceModel<TransmittancePolynomialModel, PolynomialTransmittanceOptics> {
+    : public OptionlessTransmittanceModel<TransmittancePolynomialModel,
+                                          PolynomialTransmittanceOptics, PolynomialSigmoid,
+                                          FitPolynomialSigmoid> {
   public:
-    static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit TransmittancePolynomialModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
     static ModelInfo StaticInfo();
-    PolynomialTransmittanceOptics MakeOptics(const AtmosphereParameters& atmosphere) const {
-        return PolynomialTransmittanceOptics{FitPolynomialSigmoid(atmosphere)};
-    }
 };
 
 }  // namespace atmos

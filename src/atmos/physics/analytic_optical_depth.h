@@ -179,6 +179,31 @@ ATMOS_HD inline double SegmentFromToInfinity(const F& f, double r0, double mu0, 
     return ClampLength(l);
 }
 
+// The segment [t0, t1] of the ray origin + t dir as SegmentFromToInfinity
+// takes it: the radius r and view cosine mu at its start, and its length d.
+struct RaySegmentStart {
+    double r, mu, d;
+};
+ATMOS_HD inline RaySegmentStart RaySegmentStartOf(const Vec3d& origin, const Vec3d& dir, double t0,
+                                                  double t1) {
+    const Vec3d p = origin + dir * t0;
+    const double r = Length(p);
+    return {r, ClampCosine(Dot(p, dir) / r), Max(t1 - t0, 0.0)};
+}
+
+// The optical depth of the segment [t0, t1] of the ray origin + t dir through
+// Rayleigh (scattering coefficient at the ground) and Mie (extinction), from
+// each medium's length to infinity (`rayleigh`, `mie`: functions as above).
+template <typename F>
+ATMOS_HD inline Vec3d RayleighMieSegmentDepth(const Vec3d& rayleigh_scattering, const F& rayleigh,
+                                              const Vec3d& mie_extinction, const F& mie,
+                                              const Vec3d& origin, const Vec3d& dir, double t0,
+                                              double t1) {
+    const auto [r, mu, d] = RaySegmentStartOf(origin, dir, t0, t1);
+    return rayleigh_scattering * SegmentFromToInfinity(rayleigh, r, mu, d) +
+           mie_extinction * SegmentFromToInfinity(mie, r, mu, d);
+}
+
 // ---------------------------------------------------------------------------
 // Ozone as a constant-density shell (Leenman's 2025 thesis section 10.5, Eq. 59).
 

@@ -218,12 +218,7 @@ void SpectralDataTable(const std::string& name, int column, std::vector<double>*
 }
 
 std::vector<std::string> SpectralDataNames() {
-    std::vector<std::string> names;
-    for (int i = 0; i < detail::kEmbeddedSpectrumCount; ++i) {
-        names.emplace_back(detail::kEmbeddedSpectra[i].name);
-    }
-    std::sort(names.begin(), names.end());
-    return names;
+    return detail::SortedNames(detail::kEmbeddedSpectra, detail::kEmbeddedSpectrumCount);
 }
 
 std::vector<double> ParseWavelengths(const std::string& text) {

@@ -44,6 +44,14 @@ double SumTerms(const spa::Term (&terms)[N], double jme) {
     return sum;
 }
 
+// out[i] = SumTerms of the i-th table, for the tables of one series (L0..L5,
+// B0..B1 or R0..R4).
+template <size_t... N>
+void SumEachTable(double jme, double* out, const spa::Term (&... tables)[N]) {
+    int i = 0;
+    ((out[i++] = SumTerms(tables, jme)), ...);
+}
+
 // Eqs. 10-11: (X0 + X1 JME + X2 JME^2 + ...) / 1e8, the polynomial in JME.
 double Series(const double* x, int n, double jme) {
     double v = 0.0;
@@ -266,19 +274,9 @@ SunPosition ComputeSunPosition(double julian_day_ut, const SunObserver& observer
     s.jce = (s.jde - 2451545.0) / 36525.0;
     s.jme = s.jce / 10.0;
     // 3.2: the Earth's heliocentric longitude, latitude and radius (eqs. 9-12).
-    s.l_terms[0] = SumTerms(spa::kL0, s.jme);
-    s.l_terms[1] = SumTerms(spa::kL1, s.jme);
-    s.l_terms[2] = SumTerms(spa::kL2, s.jme);
-    s.l_terms[3] = SumTerms(spa::kL3, s.jme);
-    s.l_terms[4] = SumTerms(spa::kL4, s.jme);
-    s.l_terms[5] = SumTerms(spa::kL5, s.jme);
-    s.b_terms[0] = SumTerms(spa::kB0, s.jme);
-    s.b_terms[1] = SumTerms(spa::kB1, s.jme);
-    s.r_terms[0] = SumTerms(spa::kR0, s.jme);
-    s.r_terms[1] = SumTerms(spa::kR1, s.jme);
-    s.r_terms[2] = SumTerms(spa::kR2, s.jme);
-    s.r_terms[3] = SumTerms(spa::kR3, s.jme);
-    s.r_terms[4] = SumTerms(spa::kR4, s.jme);
+    SumEachTable(s.jme, s.l_terms, spa::kL0, spa::kL1, spa::kL2, spa::kL3, spa::kL4, spa::kL5);
+    SumEachTable(s.jme, s.b_terms, spa::kB0, spa::kB1);
+    SumEachTable(s.jme, s.r_terms, spa::kR0, spa::kR1, spa::kR2, spa::kR3, spa::kR4);
     s.l = Wrap360(Deg(Series(s.l_terms, 6, s.jme)));
     s.b = Deg(Series(s.b_terms, 2, s.jme));
     s.r_au = Series(s.r_terms, 5, s.jme);

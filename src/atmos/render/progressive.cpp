@@ -19,6 +19,7 @@
 #include <string>
 
 #include "atmos/error.h"
+#include "base/fnv1a.h"
 #include "base/interrupt.h"
 #include "base/progress.h"
 #include "io/output_path.h"
@@ -142,14 +143,6 @@ ShardFile ReadShardCheckpoint(const std::string& path, const ShardFile& expected
 // render also the even passes' sum), and a 64-bit FNV-1a checksum of
 // everything before it.
 constexpr char kCheckpointMagic[8] = {'a', 't', 'm', 'o', 's', 'c', 'k', '2'};
-
-uint64_t Fnv1a(const char* data, size_t size, uint64_t h = 14695981039346656037ull) {
-    for (size_t i = 0; i < size; ++i) {
-        h ^= static_cast<unsigned char>(data[i]);
-        h *= 1099511628211ull;
-    }
-    return h;
-}
 
 struct CheckpointState {
     int64_t passes_done = 0;

@@ -81,6 +81,8 @@
 #include "base/texture.h"
 #include "physics/ray.h"
 
+#include "base/non_copyable.h"
+
 namespace atmos {
 
 // True for stages with device code (ATMOS_DEVICE_STAGE).
@@ -115,12 +117,10 @@ struct StageTime {
 
 // Installs a log that every RunStage appends to while it lives (process-wide;
 // nested scopes: the innermost wins).
-class StageLogScope {
+class StageLogScope : private NonCopyable {
   public:
     explicit StageLogScope(std::vector<StageTime>* log);
     ~StageLogScope();
-    StageLogScope(const StageLogScope&) = delete;
-    StageLogScope& operator=(const StageLogScope&) = delete;
 
   private:
     std::vector<StageTime>* previous_;
@@ -156,7 +156,7 @@ struct StageTableRef {
 
 // The device copies of one precomputation (see the top of this file). Inert on
 // the CPU backend. Process-wide while alive (the innermost is current).
-class StageSession {
+class StageSession : private NonCopyable {
   public:
     StageSession();   // joins the current session, or opens one (current while alive)
     ~StageSession();  // frees the device copies; copies nothing back
@@ -164,8 +164,6 @@ class StageSession {
     // makes it current.
     struct Detached {};
     explicit StageSession(Detached);
-    StageSession(const StageSession&) = delete;
-    StageSession& operator=(const StageSession&) = delete;
 
     // Makes the host copy of `table` current (no-op when it is, or on the CPU).
     void Download(Table* table);
@@ -238,12 +236,10 @@ class ResidentTables {
 // Makes a model's resident session current while alive (on a device backend;
 // inert on the CPU). On exit, only the tables named by Keep() stay on the
 // device.
-class ResidentScope {
+class ResidentScope : private NonCopyable {
   public:
     explicit ResidentScope(ResidentTables* tables);
     ~ResidentScope();
-    ResidentScope(const ResidentScope&) = delete;
-    ResidentScope& operator=(const ResidentScope&) = delete;
     // Keeps the device copies of the tables `evaluator` names (VisitTables).
     template <typename Evaluator>
     void Keep(const Evaluator& evaluator);

@@ -1,0 +1,28 @@
+# The layering tests (tests/CMakeLists.txt): fails when a source file
+# DIR/PREFIX*.h or DIR/PREFIX*.cpp (RECURSE=ON: in DIR's subfolders too)
+# includes a header whose path starts with FORBIDDEN (e.g. render/), unless the
+# include line matches the regular expression ALLOWED (optional). RULE is the
+# failure's first line, OK the line printed when none does.
+set(globs ${DIR}/${PREFIX}*.h ${DIR}/${PREFIX}*.cpp)
+if(RECURSE)
+  file(GLOB_RECURSE files ${globs})
+else()
+  file(GLOB files ${globs})
+endif()
+if(NOT files)
+  message(FATAL_ERROR "no sources ${DIR}/${PREFIX}*")
+endif()
+set(bad "")
+foreach(f ${files})
+  file(STRINGS ${f} lines REGEX "^[ \t]*#[ \t]*include[ \t]*[\"<]${FORBIDDEN}")
+  foreach(line ${lines})
+    if(NOT ALLOWED OR NOT line MATCHES "${ALLOWED}")
+      list(APPEND bad "${f}: ${line}")
+    endif()
+  endforeach()
+endforeach()
+if(bad)
+  string(REPLACE ";" "\n" bad "${bad}")
+  message(FATAL_ERROR "${RULE}:\n${bad}")
+endif()
+message(STATUS "${OK}")
