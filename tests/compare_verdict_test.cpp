@@ -12,6 +12,7 @@
 
 #include "atmos/error.h"
 #include "atmos/spectral.h"
+#include "compare_test_util.h"
 #include "harness/compare_regions.h"
 #include "harness/regimes.h"
 #include "harness/report.h"
@@ -301,16 +302,8 @@ TEST(CompareVerdict, RunWritesRegionsRegimesAndLuminance) {
     const fs::path dir = Dir("run");
     std::ofstream(dir / "views.json")
         << R"({"sky-5deg": {"camera": "projection=equirect", "sun": "elevation=5,azimuth=90"}})";
-    CompareRequest q;
-    q.models = {"naive:steps=8", "empty"};
-    q.views = {"ground-noon", (dir / "views.json").string()};
-    q.width = 8;
-    q.height = 4;
-    q.reference = "naive:steps=8";
-    q.output_dir = (dir / "out").string();
-    q.no_cache = true;
-    q.write_npy = false;
-    q.show_progress = false;
+    CompareRequest q = TinyCompareRequest(
+        {"naive:steps=8", "empty"}, {"ground-noon", (dir / "views.json").string()}, dir / "out");
     q.luminance = true;
     const CompareConfig config = ResolveCompareConfig(q);
     const CompareResult r = RunCompare(config);

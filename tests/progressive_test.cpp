@@ -86,15 +86,8 @@ class CoinModel : public Model {
 };
 
 RenderRequest CoinRequest(int64_t spp, int64_t pass_spp) {
-    RenderRequest r;
-    r.view = GetView("ground-noon", EarthAtmosphere());
-    r.width = 5;
-    r.height = 3;
-    r.show_progress = false;
-    r.monte_carlo.spp = spp;
-    r.monte_carlo.seed = 11;
-    r.monte_carlo.pass_spp = pass_spp;
-    return r;
+    return atmos_test::MonteCarloRequest(GetView("ground-noon", EarthAtmosphere()), 5, 3, spp,
+                                         pass_spp, 11);
 }
 
 std::filesystem::path TestDir(const char* name) { return atmos_test::FreshTestTmpDir(name); }

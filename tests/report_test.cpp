@@ -26,6 +26,7 @@
 #include "harness/profiles.h"
 #include "harness/ranking.h"
 #include "harness/report.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
@@ -48,11 +49,7 @@ int System(const std::string& cmd) {
 TEST(Report, LoadsInHeadlessChromiumWithEveryImage) {
     const std::string chromium = FindChromium();
     if (chromium.empty()) GTEST_SKIP() << "chromium not installed (scripts/setup.sh installs it)";
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
-    dir /= "report_" + std::to_string(getpid());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = atmos_test::FreshTestTmpDir("report_" + std::to_string(getpid()));
 
     // A small report: 2 views x (reference + 2 models x (image, FLIP map, error)) = 14 images;
     // plots: accuracy against cost, render times, per view the colour bars and 2 profiles = 8.

@@ -26,6 +26,7 @@
 #include "metrics/flip.h"
 #include "render/progressive.h"
 #include "render/shards.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -81,15 +82,8 @@ class DiceModel : public MonteCarloModel {
 };
 
 RenderRequest DiceRequest(int64_t spp, int64_t pass_spp, uint64_t seed = 5) {
-    RenderRequest r;
-    r.view = GetView("ground-noon", EarthAtmosphere());
-    r.width = 7;
-    r.height = 4;
-    r.show_progress = false;
-    r.monte_carlo.spp = spp;
-    r.monte_carlo.seed = seed;
-    r.monte_carlo.pass_spp = pass_spp;
-    return r;
+    return atmos_test::MonteCarloRequest(GetView("ground-noon", EarthAtmosphere()), 7, 4, spp,
+                                         pass_spp, seed);
 }
 
 fs::path TestDir(const char* name) {

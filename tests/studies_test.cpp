@@ -13,6 +13,7 @@
 
 #include "atmos/error.h"
 #include "atmos/image.h"
+#include "compare_test_util.h"
 #include "studies/bench.h"
 #include "studies/compare.h"
 #include "studies/spectral_sample.h"
@@ -192,16 +193,9 @@ TEST(StudiesCompare, ResolveAppliesTheDefaultsAndThePolicy) {
 }
 
 TEST(StudiesCompare, RunOnTinyImages) {
-    CompareRequest q;
-    q.models = {"naive:steps=8", "empty"};
-    q.views = {"ground-noon", "space"};
-    q.width = 8;
-    q.height = 4;
-    q.reference = "naive:steps=8";  // the first model is the reference itself
-    q.output_dir = TestDir("compare").string();
-    q.no_cache = true;
-    q.write_npy = false;
-    q.show_progress = false;
+    // The first model is the reference itself.
+    const CompareRequest q = TinyCompareRequest({"naive:steps=8", "empty"},
+                                                {"ground-noon", "space"}, TestDir("compare"));
     const CompareConfig config = ResolveCompareConfig(q);
     const CompareResult r = RunCompare(config);
     ASSERT_EQ(r.models.size(), 2u);

@@ -201,6 +201,17 @@ inline atmos::RenderRequest QuietRequest(const atmos::View& view, int width, int
     return request;
 }
 
+// QuietRequest for a Monte Carlo model: spp paths per pixel in passes of
+// pass_spp from `seed`.
+inline atmos::RenderRequest MonteCarloRequest(const atmos::View& view, int width, int height,
+                                              int64_t spp, int64_t pass_spp, uint64_t seed) {
+    atmos::RenderRequest request = QuietRequest(view, width, height);
+    request.monte_carlo.spp = spp;
+    request.monte_carlo.seed = seed;
+    request.monte_carlo.pass_spp = pass_spp;
+    return request;
+}
+
 }  // namespace atmos_test
 
 // `statement` throws an atmos::Error whose message contains `text`.

@@ -22,6 +22,7 @@
 #include "atmos/image.h"
 #include "chromium_util.h"
 #include "metrics/flip.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
@@ -94,11 +95,7 @@ void ExpectBrowserMatchesAtmosRender(const std::string& sets) {
 #endif
     const std::string chromium = FindChromium();
     if (chromium.empty()) GTEST_SKIP() << "chromium not installed (scripts/setup.sh installs it)";
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
-    dir /= "viewer_" + std::to_string(getpid());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = atmos_test::FreshTestTmpDir("viewer_" + std::to_string(getpid()));
     const fs::path page = dir / "page";
     const std::string cli = ATMOS_CLI_PATH;
 

@@ -170,13 +170,7 @@ function makeModel(gl, name, format) {
   var fragment = '#version 300 es\nprecision highp float;\nprecision highp sampler2D;\n' +
                  'precision highp sampler3D;\n' + data.constants + '\n' + data.functions +
                  '\n' + MAIN_SHADER;
-  var program = gl.createProgram();
-  gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, VERTEX_SHADER));
-  gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, fragment));
-  gl.linkProgram(program);
-  if (!gl.getProgramParameter(program, gl.LINK_STATUS)) {
-    throw new Error('link error: ' + gl.getProgramInfoLog(program));
-  }
+  var program = linkProgram(gl, fragment);
   var blob = decodeBase64(blobText);
   var raw = data.bake.raw.tables;
   // Texture units: the sampler names of the model's GLSL file.

@@ -155,6 +155,13 @@ void WriteGlslAtmosphere(std::ostream& s, const AtmosphereParameters& a) {
     s.precision(precision);
 }
 
+void BeginGlslConstants(std::ostream& s, const char* header, const AtmosphereParameters& a) {
+    s << header;
+    WriteGlslAtmosphere(s, a);
+    s.precision(9);
+    s << std::scientific;
+}
+
 nlohmann::ordered_json WriteGlslConstants(const std::string& directory, const std::string& stem,
                                           const std::string& text) {
     namespace fs = std::filesystem;

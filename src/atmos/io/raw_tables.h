@@ -47,6 +47,10 @@ uint16_t FloatToHalf(float x);
 // vec4(exp_term, exp_scale, linear_term, constant_term), the same for MIE and
 // ABSORPTION).
 void WriteGlslAtmosphere(std::ostream& s, const AtmosphereParameters& a);
+// A bake's constants file up to its model's own #defines: `header` (the
+// comment lines), WriteGlslAtmosphere, and the stream left in scientific
+// notation with 9 digits for the model's values.
+void BeginGlslConstants(std::ostream& s, const char* header, const AtmosphereParameters& a);
 
 // Writes DIR/shaders/STEM_constants.glsl (a bake's #defines, `text`) and
 // returns the bake JSON's "shaders": the constants, shaders/common.glsl and

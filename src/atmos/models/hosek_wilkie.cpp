@@ -264,12 +264,12 @@ constexpr int kBakeFormatVersion = 1;
 // at kHosekWilkieMaxSources c + s), from the evaluator Prepare() built.
 std::string GlslConstants(const AtmosphereParameters& a, const HosekWilkieEvaluator& e) {
     std::ostringstream o;
-    o << "// atmos bake: the constants of the hosek-wilkie model (Hosek & Wilkie 2012, "
-         "eq. 8-9),\n// blended in turbidity and albedo; read by shaders/common.glsl and "
-         "shaders/hosek_wilkie.glsl.\n";
-    WriteGlslAtmosphere(o, a);
-    o.precision(9);
-    o << std::scientific;
+    BeginGlslConstants(
+        o,
+        "// atmos bake: the constants of the hosek-wilkie model (Hosek & Wilkie 2012, "
+        "eq. 8-9),\n// blended in turbidity and albedo; read by shaders/common.glsl and "
+        "shaders/hosek_wilkie.glsl.\n",
+        a);
     o << "#define ATMOS_HW_SOURCES " << e.sources << "\n";
     o << "const float ATMOS_HW_CONTROL[" << e.sources * 60 << "] = float[](";
     for (int s = 0; s < e.sources; ++s) {

@@ -19,7 +19,7 @@
 #include <string>
 
 #include "atmos/error.h"
-#include "base/fnv1a.h"
+#include "base/framed_file.h"
 #include "base/interrupt.h"
 #include "base/progress.h"
 #include "io/output_path.h"
@@ -183,20 +183,14 @@ void WriteCheckpoint(const std::string& path, const nlohmann::json& key,
     header["pass_samples"] = state.pass_samples;
     header["even_sum"] = state.sum_even.size() > 0;
     const std::string text = header.dump();
-    const uint64_t header_size = text.size();
     const size_t image_bytes = state.sum.size() * sizeof(float);
-    std::string bytes;
-    bytes.reserve(sizeof kCheckpointMagic + 8 + text.size() + 2 * image_bytes + 8);
-    bytes.append(kCheckpointMagic, sizeof kCheckpointMagic);
-    bytes.append(reinterpret_cast<const char*>(&header_size), sizeof header_size);
-    bytes.append(text);
+    std::string bytes = BeginFrame(kCheckpointMagic, text, 3 * image_bytes);
     bytes.append(reinterpret_cast<const char*>(state.sum.data()), image_bytes);
     bytes.append(reinterpret_cast<const char*>(state.sum_sq.data()), image_bytes);
     if (state.sum_even.size() > 0) {
         bytes.append(reinterpret_cast<const char*>(state.sum_even.data()), image_bytes);
     }
-    const uint64_t checksum = Fnv1a(bytes.data(), bytes.size());
-    bytes.append(reinterpret_cast<const char*>(&checksum), sizeof checksum);
+    EndFrame(&bytes);
     CommitCheckpoint(path, bytes);
 }
 
@@ -263,15 +257,11 @@ CheckpointState ReadCheckpoint(const std::string& path, const nlohmann::json& ke
     std::ifstream f(path, std::ios::binary);
     if (!f) Fail("cannot read checkpoint '", path, "'");
     const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    const size_t fixed = sizeof kCheckpointMagic + 8 + 8;
-    if (bytes.size() < fixed || bytes.compare(0, 8, kCheckpointMagic, 8) != 0) {
-        damaged("not an atmos checkpoint, or truncated");
-    }
-    uint64_t header_size = 0, checksum = 0;
-    std::memcpy(&header_size, bytes.data() + 8, sizeof header_size);
-    std::memcpy(&checksum, bytes.data() + bytes.size() - 8, sizeof checksum);
-    if (header_size > bytes.size() - fixed) damaged("truncated header");
-    if (Fnv1a(bytes.data(), bytes.size() - 8) != checksum) damaged("checksum mismatch");
+    const size_t fixed = kFrameOverhead;
+    const uint64_t header_size = CheckFrame(
+        bytes, kCheckpointMagic,
+        {"not an atmos checkpoint, or truncated", "truncated header", "checksum mismatch"},
+        damaged);
     nlohmann::json header;
     try {
         header = nlohmann::json::parse(bytes.substr(16, header_size));

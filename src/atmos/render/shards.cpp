@@ -13,6 +13,7 @@
 #include <string>
 
 #include "atmos/error.h"
+#include "base/framed_file.h"
 #include "io/bounded_read.h"
 #include "metrics/flip.h"
 #include "render/progressive.h"
@@ -23,15 +24,6 @@ namespace {
 
 constexpr char kShardMagic[8] = {'a', 't', 'm', 'o', 's', 's', 'h', '1'};
 constexpr const char* kShardFormat = "atmos-shard-1";
-
-uint64_t ShardChecksum(const char* data, size_t size) {
-    uint64_t h = 14695981039346656037ull;  // FNV-1a 64
-    for (size_t i = 0; i < size; ++i) {
-        h ^= static_cast<unsigned char>(data[i]);
-        h *= 1099511628211ull;
-    }
-    return h;
-}
 
 void AppendImage(std::string* bytes, const Image& image) {
     bytes->append(reinterpret_cast<const char*>(image.data()), image.size() * sizeof(float));
@@ -81,14 +73,10 @@ std::string SerializeShardFile(const ShardFile& file) {
     }
     header["extra"] = nlohmann::json::parse(file.extra);
     const std::string text = header.dump();
-    const uint64_t header_size = text.size();
-    std::string bytes(kShardMagic, sizeof kShardMagic);
-    bytes.append(reinterpret_cast<const char*>(&header_size), sizeof header_size);
-    bytes.append(text);
+    std::string bytes = BeginFrame(kShardMagic, text);
     for (const MonteCarloPassImage& p : s.pass_images) AppendImage(&bytes, p.mean);
     if (file.rows_done > 0) AppendImage(&bytes, file.partial.mean);
-    const uint64_t checksum = ShardChecksum(bytes.data(), bytes.size());
-    bytes.append(reinterpret_cast<const char*>(&checksum), sizeof checksum);
+    EndFrame(&bytes);
     return bytes;
 }
 
@@ -96,17 +84,12 @@ ShardFile ParseShardFile(const std::string& bytes, const std::string& what) {
     auto bad = [&](const std::string& why) {
         Fail(what, " is not a usable atmos shard (", why, ")");
     };
-    const size_t fixed = sizeof kShardMagic + 8 + 8;
-    if (bytes.size() < fixed || bytes.compare(0, 8, kShardMagic, 8) != 0) {
-        bad("no shard header: not written by `atmos render --shard`, or truncated");
-    }
-    uint64_t header_size = 0, checksum = 0;
-    std::memcpy(&header_size, bytes.data() + 8, sizeof header_size);
-    std::memcpy(&checksum, bytes.data() + bytes.size() - 8, sizeof checksum);
-    if (header_size > bytes.size() - fixed) bad("truncated header");
-    if (ShardChecksum(bytes.data(), bytes.size() - 8) != checksum) {
-        bad("checksum mismatch: damaged or truncated");
-    }
+    const size_t fixed = kFrameOverhead;
+    const uint64_t header_size =
+        CheckFrame(bytes, kShardMagic,
+                   {"no shard header: not written by `atmos render --shard`, or truncated",
+                    "truncated header", "checksum mismatch: damaged or truncated"},
+                   bad);
     ShardFile file;
     MonteCarloShard& s = file.shard;
     int64_t pass_spp = 0;
