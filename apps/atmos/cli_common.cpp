@@ -102,18 +102,6 @@ double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphe
     return Seconds(start);
 }
 
-RenderRequest ViewRequest(const View& view, int width, int height, Quantity quantity,
-                          const MonteCarloSettings& monte_carlo) {
-    RenderRequest request;
-    request.view = view;
-    request.width = width;
-    request.height = height;
-    request.quantity = quantity;
-    request.show_progress = false;
-    request.monte_carlo = monte_carlo;
-    return request;
-}
-
 SpectralBatching ParseSpectralBatching(const SpectralFlags& flags) {
     SpectralBatching batching;
     batching.seeds = ParseBatchSeeds(flags.batch_seeds);

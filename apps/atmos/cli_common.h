@@ -76,11 +76,6 @@ void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour = true);
 // --batch-seeds and --batch-layout as parsed values (throws on an unknown name).
 SpectralBatching ParseSpectralBatching(const SpectralFlags& flags);
 
-// The request of one view at a size and quantity with Monte Carlo settings, no
-// progress bar (callers set the rest).
-RenderRequest ViewRequest(const View& view, int width, int height, Quantity quantity,
-                          const MonteCarloSettings& monte_carlo);
-
 // A registered subcommand: its CLI11 app and what runs it (returns the exit status).
 struct Command {
     CLI::App* app = nullptr;

@@ -15,7 +15,7 @@
 #include "atmos/error.h"
 #include "cli_common.h"
 #include "harness/listing.h"
-#include "mpi_world.h"
+#include "harness/mpi_world.h"
 
 namespace {
 
@@ -125,9 +125,9 @@ int RunCommand(int argc, char** argv) {
 int main(int argc, char** argv) {
     // Under an MPI launcher (mpirun, srun): MPI for the process's life; a
     // failure on one rank ends them all (mpi_world.h).
-    std::unique_ptr<atmos::cli::MpiSession> mpi;
+    std::unique_ptr<atmos::MpiSession> mpi;
     try {
-        mpi = std::make_unique<atmos::cli::MpiSession>(&argc, &argv);
+        mpi = std::make_unique<atmos::MpiSession>(&argc, &argv);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "atmos: error: %s\n", e.what());
         return 2;

@@ -1,5 +1,5 @@
-// atmos CLI: MPI (see mpi_world.h).
-#include "mpi_world.h"
+// atmos: MPI for the command-line tool (see mpi_world.h).
+#include "harness/mpi_world.h"
 
 #include <cstdint>
 #include <cstdlib>
@@ -12,7 +12,7 @@
 #include <mpi.h>
 #endif
 
-namespace atmos::cli {
+namespace atmos {
 
 namespace {
 
@@ -157,4 +157,4 @@ std::vector<MonteCarloShard> GatherShards(MonteCarloShard local) {
 
 #endif
 
-}  // namespace atmos::cli
+}  // namespace atmos

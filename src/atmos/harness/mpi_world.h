@@ -1,9 +1,11 @@
-// atmos CLI: MPI (issue 36). `mpirun -np N atmos render ...` spreads the passes
-// of a Monte Carlo render over the N ranks (rank r renders shard r + 1 of N,
+// atmos: MPI for the command-line tool (issue 36). `mpirun -np N atmos render ...` spreads the
+// passes of a Monte Carlo render over the N ranks (rank r renders shard r + 1 of N,
 // render/shards.h); rank 0 gathers the passes, merges them in pass order and
 // writes the image one process would have written, byte for byte.
 //
-// Built with MPI when CMake finds it (ATMOS_MPI=AUTO|ON|OFF; ATMOS_HAVE_MPI).
+// Built with MPI when CMake finds it (ATMOS_MPI=AUTO|ON|OFF; ATMOS_HAVE_MPI),
+// and only into the `atmos` executable (CMakeLists.txt leaves this file's .cpp
+// out of the library: the library, tests and Python module never link MPI).
 // MPI is started only when an MPI launcher (mpirun, mpiexec, srun) started the
 // process, so a plain `atmos ...` never touches it; a build without MPI that
 // an MPI launcher starts with more than one rank refuses to run (every rank
@@ -15,7 +17,7 @@
 #include "atmos/model.h"
 #include "render/shards.h"
 
-namespace atmos::cli {
+namespace atmos {
 
 struct MpiWorld {
     int rank = 0;
@@ -44,4 +46,4 @@ const MpiWorld& World();
 // rank 0, every rank's shard in rank order (its own first); elsewhere, empty.
 std::vector<MonteCarloShard> GatherShards(MonteCarloShard local);
 
-}  // namespace atmos::cli
+}  // namespace atmos
