@@ -18,35 +18,19 @@
 #include "harness/report.h"
 #include "studies/compare.h"
 #include "studies/compare_views.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace atmos {
 namespace {
 
-fs::path Dir(const std::string& name) {
-    const char* env = std::getenv("ATMOS_TEST_TMP");
-    fs::path dir = env ? fs::path(env) : fs::temp_directory_path() / "atmos_test";
-    dir /= "verdict_" + name;
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+fs::path Dir(const std::string& name) { return atmos_test::FreshTestTmpDir("verdict_" + name); }
 
-std::string Slurp(const fs::path& path) {
-    std::ifstream f(path);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
+using atmos_test::Slurp;
 
 std::string ErrorOf(const std::string& json) {
-    try {
-        ParseCompareViews(json, "v.json", 8, 4);
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
+    return atmos_test::ErrorOrEmpty([&] { ParseCompareViews(json, "v.json", 8, 4); });
 }
 
 // --- views files ------------------------------------------------------------

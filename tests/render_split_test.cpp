@@ -13,20 +13,12 @@
 #include "atmos/model.h"
 #include "harness/render_run.h"
 #include "harness/render_split.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
 
-// The message of the atmos::Error `f` throws ("" when it throws none).
-template <typename F>
-std::string ErrorOf(F f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
+using atmos_test::ErrorOrEmpty;
 
 TEST(RenderSplit, ParsesShardKOfN) {
     int64_t index = -1, count = -1;
@@ -45,7 +37,7 @@ TEST(RenderSplit, RefusesMalformedShards) {
     for (const char* text : {"", "2", "/8", "2/", "0/8", "9/8", "-1/8", "2/0", "a/8", "2/b", "2/8x",
                              "2x/8", "1/1000001", "1/2/3", "2.0/8", "99999999999999999999/8"}) {
         int64_t index = 0, count = 0;
-        EXPECT_EQ(ErrorOf([&] { ParseShardSpec(text, &index, &count); }),
+        EXPECT_EQ(ErrorOrEmpty([&] { ParseShardSpec(text, &index, &count); }),
                   std::string("--shard must be K/N with 1 <= K <= N <= 1000000 (shard K of N, "
                               "e.g. 2/8), got '") +
                       text + "'")
@@ -72,7 +64,7 @@ RenderSplit Shard(const std::string& text, int64_t extend_from = 0) {
 
 TEST(RenderSplit, AcceptsShardsAndRoundsAndGivesTheirPasses) {
     RenderSplit split = Shard("3/4", 16);
-    EXPECT_EQ(ErrorOf([&] { CheckRenderSplit(&split, ShardTarget()); }), "");
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderSplit(&split, ShardTarget()); }), "");
     EXPECT_TRUE(split.sharded());
     EXPECT_TRUE(split.split());
     const MonteCarloShard shard = RenderSplitShard(split, 8);
@@ -83,7 +75,7 @@ TEST(RenderSplit, AcceptsShardsAndRoundsAndGivesTheirPasses) {
     RenderSplitTarget stream = ShardTarget();
     stream.output = "/dev/stdout";
     split = Shard("1/2");
-    EXPECT_EQ(ErrorOf([&] { CheckRenderSplit(&split, stream); }), "");
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderSplit(&split, stream); }), "");
 }
 
 TEST(RenderSplit, MpiRanksAreTheShards) {
@@ -92,7 +84,7 @@ TEST(RenderSplit, MpiRanksAreTheShards) {
     split.world_size = 3;
     RenderSplitTarget target = ShardTarget();
     target.output = "sky.exr";
-    EXPECT_EQ(ErrorOf([&] { CheckRenderSplit(&split, target); }), "");
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderSplit(&split, target); }), "");
     EXPECT_FALSE(split.sharded());
     EXPECT_TRUE(split.split());
     const MonteCarloShard shard = RenderSplitShard(split, 8);
@@ -104,13 +96,13 @@ TEST(RenderSplit, MpiRanksAreTheShards) {
     target.quantity = Quantity::kTransmittance;
     target.spectral = true;
     target.noise_target = true;
-    EXPECT_EQ(ErrorOf([&] { CheckRenderSplit(&none, target); }), "");
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderSplit(&none, target); }), "");
     EXPECT_FALSE(none.split());
 }
 
 TEST(RenderSplit, RefusesSplitsTheRenderCannotMake) {
     auto refusal = [](RenderSplit split, const RenderSplitTarget& target) {
-        return ErrorOf([&] { CheckRenderSplit(&split, target); });
+        return ErrorOrEmpty([&] { CheckRenderSplit(&split, target); });
     };
     RenderSplit mpi = Shard("1/2");
     mpi.world_size = 2;
@@ -170,20 +162,20 @@ TEST(RenderSplit, RefusesADeterministicModel) {
     info.name = "naive";
     info.capabilities.stochastic = false;
     RenderSplit split = Shard("1/2");
-    EXPECT_EQ(ErrorOf([&] { CheckRenderSplitModel(split, info); }),
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderSplitModel(split, info); }),
               "--shard splits the passes of a Monte Carlo model; model naive is not one (`atmos "
               "list` marks them)");
-    EXPECT_EQ(ErrorOf([&] { CheckRenderSplitModel(RenderSplit(), info); }), "");
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderSplitModel(RenderSplit(), info); }), "");
     info.capabilities.stochastic = true;
-    EXPECT_EQ(ErrorOf([&] { CheckRenderSplitModel(split, info); }), "");
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderSplitModel(split, info); }), "");
 }
 
 TEST(RenderSplit, MergeRefusesBeforeReadingAnything) {
-    EXPECT_EQ(ErrorOf([] { MergeShardFilesToImage({"a.shard"}, "", 0.0f, true); }),
+    EXPECT_EQ(ErrorOrEmpty([] { MergeShardFilesToImage({"a.shard"}, "", 0.0f, true); }),
               "merge needs an output: -o FILE (.exr .png .npy .pfm)");
-    EXPECT_EQ(ErrorOf([] { MergeShardFilesToImage({}, "sky.exr", 0.0f, true); }),
+    EXPECT_EQ(ErrorOrEmpty([] { MergeShardFilesToImage({}, "sky.exr", 0.0f, true); }),
               "merge needs the shards: atmos merge PART.shard... -o FILE");
-    EXPECT_EQ(ErrorOf([] { MergeShardFilesToImage({"a.shard"}, "sky.exr", -1.0f, true); }),
+    EXPECT_EQ(ErrorOrEmpty([] { MergeShardFilesToImage({"a.shard"}, "sky.exr", -1.0f, true); }),
               "--exposure must be a positive number");
 }
 
@@ -192,24 +184,26 @@ TEST(RenderRun, RefusesBadExposureAndCheckpointInterval) {
     std::filesystem::create_directories(dir);
     RenderRun run;
     run.output = (dir / "sky.xyz").string();
-    EXPECT_EQ(ErrorOf([&] { CheckRenderRun(run, 10.0); }),
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderRun(run, 10.0); }),
               "cannot tell the image format of '" + run.output +
                   "': unknown extension '.xyz' (allowed: .exr .png .npy .pfm)");
     run.output = (dir / "sky.exr").string();
-    EXPECT_EQ(ErrorOf([&] { CheckRenderRun(run, 10.0); }), "");
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderRun(run, 10.0); }), "");
     run.output = (dir / "missing" / "sky.exr").string();
-    EXPECT_NE(ErrorOf([&] { CheckRenderRun(run, 10.0); }), "");
+    EXPECT_NE(ErrorOrEmpty([&] { CheckRenderRun(run, 10.0); }), "");
     run.split.world_rank = 1;  // under mpirun rank 0 writes the output
-    EXPECT_EQ(ErrorOf([&] { CheckRenderRun(run, 10.0); }), "");
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderRun(run, 10.0); }), "");
     run.output = (dir / "sky.exr").string();
     run.split.world_rank = 0;
     run.exposure = -1.0f;
-    EXPECT_EQ(ErrorOf([&] { CheckRenderRun(run, 10.0); }), "--exposure must be a positive number");
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderRun(run, 10.0); }),
+              "--exposure must be a positive number");
     run.exposure = std::numeric_limits<float>::quiet_NaN();
-    EXPECT_EQ(ErrorOf([&] { CheckRenderRun(run, 10.0); }), "--exposure must be a positive number");
+    EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderRun(run, 10.0); }),
+              "--exposure must be a positive number");
     run.exposure = 0.0f;
     for (double every : {-1.0, 2e6, std::numeric_limits<double>::quiet_NaN()}) {
-        EXPECT_EQ(ErrorOf([&] { CheckRenderRun(run, every); }),
+        EXPECT_EQ(ErrorOrEmpty([&] { CheckRenderRun(run, every); }),
                   "--checkpoint-every must be in [0, 1e6] seconds")
             << every;
     }

@@ -34,17 +34,8 @@ namespace {
 
 using atmos::test::FindChromium;
 
-std::string Slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
-
-int System(const std::string& cmd) {
-    const int raw = std::system(cmd.c_str());
-    return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-}
+using atmos_test::Slurp;
+using atmos_test::System;
 
 TEST(Report, LoadsInHeadlessChromiumWithEveryImage) {
     const std::string chromium = FindChromium();

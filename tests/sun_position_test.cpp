@@ -11,20 +11,12 @@
 
 #include "atmos/error.h"
 #include "atmos/sun_position.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
 
-// The error message of `f`, or "" when it does not throw atmos::Error.
-template <typename F>
-std::string ErrorOf(F f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
+using atmos_test::ErrorOrEmpty;
 
 // Reda & Andreas (2004), Appendix A.5: 2003-10-17 12:30:30 local standard time,
 // time zone -7 h, latitude 39.742476, longitude -105.1786, elevation 1830.14 m,
@@ -168,7 +160,7 @@ TEST(SunPosition, Iso8601ErrorsNameTheField) {
         {"6001-01-01T00:00:00Z", "year 6001 is outside 0001..6000"},
     };
     for (const Case& c : cases) {
-        const std::string e = ErrorOf([&] { ParseIso8601(c.text, "row 7: time"); });
+        const std::string e = ErrorOrEmpty([&] { ParseIso8601(c.text, "row 7: time"); });
         EXPECT_NE(e.find("row 7: time: '"), std::string::npos) << c.text << ": " << e;
         EXPECT_NE(e.find(c.expect), std::string::npos) << c.text << ": " << e;
     }
@@ -238,7 +230,7 @@ TEST(SunPosition, SpecParser) {
         {"time=2024-06-21T12:00:00Z,latitude=0,,longitude=0", "'' is not KEY=VALUE"},
     };
     for (const Case& c : cases) {
-        const std::string e = ErrorOf([&] { ParseSunTimeSpec(c.spec); });
+        const std::string e = ErrorOrEmpty([&] { ParseSunTimeSpec(c.spec); });
         EXPECT_NE(e.find("--sun"), std::string::npos) << c.spec << ": " << e;
         EXPECT_NE(e.find(c.expect), std::string::npos) << c.spec << ": " << e;
     }

@@ -55,10 +55,16 @@ inline std::filesystem::path FreshTestTmpDir(const std::string& name) {
 
 // A file's bytes ("" when it cannot be read).
 inline std::string Slurp(const std::filesystem::path& path) {
-    std::ifstream f(path);
+    std::ifstream f(path, std::ios::binary);
     std::stringstream ss;
     ss << f.rdbuf();
     return ss.str();
+}
+
+// Runs the shell command line `cmd`; its exit status, -1 when a signal ended it.
+inline int System(const std::string& cmd) {
+    const int raw = std::system(cmd.c_str());
+    return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
 }
 
 struct CommandOutcome {
@@ -164,9 +170,10 @@ template <typename... Stages>
 constexpr bool kAreDeviceStages =
     ((std::is_trivially_copyable<Stages>::value && atmos::HasDeviceStage<Stages>::value) && ...);
 
-// Runs `f`, expects atmos::Error, and returns its message ("" if none was thrown).
+// The message of the atmos::Error `f` throws; "" when it throws none (a
+// failure when `f` must throw) or another exception (always a failure).
 template <typename F>
-std::string ErrorMessage(F f) {
+std::string ErrorOrEmpty(F f, bool must_throw = false) {
     try {
         f();
     } catch (const atmos::Error& e) {
@@ -175,8 +182,14 @@ std::string ErrorMessage(F f) {
         ADD_FAILURE() << "threw a non-atmos exception: " << e.what();
         return "";
     }
-    ADD_FAILURE() << "did not throw";
+    if (must_throw) ADD_FAILURE() << "did not throw";
     return "";
+}
+
+// Runs `f`, expects atmos::Error, and returns its message ("" if none was thrown).
+template <typename F>
+std::string ErrorMessage(F f) {
+    return ErrorOrEmpty(f, true);
 }
 
 // The tables of a test stage (render/stages.h) that reads `in` and writes or

@@ -30,17 +30,8 @@ namespace {
 
 using atmos::test::FindChromium;
 
-std::string Slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
-
-int System(const std::string& cmd) {
-    const int raw = std::system(cmd.c_str());
-    return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-}
+using atmos_test::Slurp;
+using atmos_test::System;
 
 std::string DecodeBase64(const std::string& text) {
     std::string out;

@@ -141,13 +141,23 @@ py::dict CompareDict(const CompareConfig& config, const CompareResult& r) {
     return d;
 }
 
+// One dict per item (its "model" and "view", then what `fill` adds), as a list.
+template <typename T, typename F>
+py::list ModelViewDicts(const std::vector<T>& items, F fill) {
+    py::list out;
+    for (const T& item : items) {
+        py::dict e;
+        e["model"] = item.model;
+        e["view"] = item.view;
+        fill(item, e);
+        out.append(e);
+    }
+    return out;
+}
+
 py::dict BenchDict(const BenchResult& r) {
     py::dict d;
-    py::list rows, stages, spectral;
-    for (const BenchRow& b : r.rows) {
-        py::dict e;
-        e["model"] = b.model;
-        e["view"] = b.view;
+    const py::list rows = ModelViewDicts(r.rows, [](const BenchRow& b, py::dict& e) {
         e["prepare_s"] = b.prepare_s;
         e["render_median_s"] = b.render_median_s;
         e["render_min_s"] = b.render_min_s;
@@ -155,30 +165,22 @@ py::dict BenchDict(const BenchResult& r) {
         e["runs"] = b.runs;
         e["megapixels_per_s"] = b.megapixels_per_s;
         e["paths_per_s"] = b.paths_per_s;
-        rows.append(e);
-    }
-    for (const BenchStage& s : r.stages) {
-        py::dict e;
-        e["model"] = s.model;
-        e["view"] = s.view;
+    });
+    const py::list stages = ModelViewDicts(r.stages, [](const BenchStage& s, py::dict& e) {
         e["stage"] = s.name;
         e["items"] = s.items;
         e["runs"] = s.runs;
         e["kernel_median_ms"] = s.kernel_median_ms;
         e["total_median_ms"] = s.total_median_ms;
-        stages.append(e);
-    }
-    for (const BenchSpectralRow& s : r.spectral_rows) {
-        py::dict e;
-        e["model"] = s.model;
-        e["view"] = s.view;
-        e["wavelengths"] = s.wavelengths;
-        e["rgb_prepare_s"] = s.rgb_prepare_s;
-        e["rgb_render_s"] = s.rgb_render_s;
-        e["spectral_prepare_s"] = s.spectral_prepare_s;
-        e["spectral_render_s"] = s.spectral_render_s;
-        spectral.append(e);
-    }
+    });
+    const py::list spectral =
+        ModelViewDicts(r.spectral_rows, [](const BenchSpectralRow& s, py::dict& e) {
+            e["wavelengths"] = s.wavelengths;
+            e["rgb_prepare_s"] = s.rgb_prepare_s;
+            e["rgb_render_s"] = s.rgb_render_s;
+            e["spectral_prepare_s"] = s.spectral_prepare_s;
+            e["spectral_render_s"] = s.spectral_render_s;
+        });
     d["rows"] = rows;
     d["stages"] = stages;
     d["spectral"] = spectral;
