@@ -16,7 +16,8 @@ Prints one Markdown table row per case, direction and estimator, and the CPU sec
 Usage:
   scripts/disort_benchmark.py [--atmos build/atmos] [--spp 4096] [--seeds 16]
       [--models reference,reference:estimator=tracking] [--cases 2A,2B,2C,2D]
-      [--thickness 1000] [--radius 1e9] [--max-order 0]
+      [--thickness 1000] [--radius 1e9] [--max-order 0] [--where all|top|ground]
+      [--single-scattering]
 """
 import argparse
 import csv
@@ -105,6 +106,8 @@ def main():
     p.add_argument("--thickness", type=float, default=1000.0, help="the shell's thickness H (m)")
     p.add_argument("--radius", type=float, default=1e9, help="the planet's radius (m)")
     p.add_argument("--max-order", type=int, default=0, help="0: all orders")
+    p.add_argument("--where", choices=("all", "top", "ground"), default="all",
+                   help="only the light leaving the top, or only the light reaching the ground")
     p.add_argument("--single-scattering", action="store_true",
                    help="compare order 1 (max-order 1) with the plane-parallel closed form "
                    "instead of the published all-orders values (checks the emulation)")
@@ -120,7 +123,8 @@ def main():
     worst = 0.0
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.cases.split(","):
-            rows = cases[name]
+            rows = [r for r in cases[name] if args.where == "all" or
+                    (float(r["umu"]) > 0) == (args.where == "top")]
             tau, ssalb = float(rows[0]["tau"]), float(rows[0]["ssalb"])
             atm_path = os.path.join(tmp, "slab_%s.json" % name)
             with open(atm_path, "w") as f:
