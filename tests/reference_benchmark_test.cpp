@@ -20,7 +20,6 @@
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "models/reference.h"
-#include "physics/phase.h"
 #include "render/render.h"
 
 namespace atmos {
