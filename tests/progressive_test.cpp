@@ -453,3 +453,57 @@ TEST(Progressive, ACheckpointInsideAPassResumesToTheSameImage) {
 
 }  // namespace
 }  // namespace atmos
+
+namespace atmos {
+namespace {
+
+// A noise-targeted render returns the halves' per-pixel FLIP map with its
+// noise (issue 33 item 2: the reference's noise per region): the map of the
+// even pass against the odd one, whose float32 mean is the noise; a render
+// resumed from a checkpoint that already reached its target measures it at
+// resume time and returns the same map; a fixed-spp render returns none.
+TEST(Progressive, ANoiseTargetReturnsTheHalvesFlipMap) {
+    const CoinModel model(true);
+    RenderRequest request = CoinRequest(12, 3);
+    MonteCarloReport report;
+    request.report = &report;
+    Image image;
+    model.Render(request, &image);
+    EXPECT_LT(report.noise, 0.0);
+    EXPECT_TRUE(report.noise_map.empty());
+    request.monte_carlo.noise_target = 0.99;  // reached after one pair
+    const std::filesystem::path dir = TestDir("progressive_noise_map");
+    request.checkpoint = (dir / "coin").string();
+    model.Render(request, &image);
+    EXPECT_EQ(report.samples, 6);
+    Image even, odd;
+    MonteCarloPass pass;
+    pass.seed = 11;
+    pass.samples = 3;
+    model.RenderPass(request, pass, &even, nullptr);
+    pass.first_sample = 3;
+    model.RenderPass(request, pass, &odd, nullptr);
+    const FlipResult halves = HdrFlip(even, odd);
+    ASSERT_EQ(report.noise_map.size(), static_cast<size_t>(request.width * request.height));
+    float sum = 0.0f;
+    for (size_t i = 0; i < report.noise_map.size(); ++i) {
+        EXPECT_NEAR(report.noise_map[i], halves.map[i], 1e-5) << i;
+        sum += report.noise_map[i];
+    }
+    EXPECT_EQ(report.noise, static_cast<double>(sum) / static_cast<double>(halves.map.size()));
+    // Resumed: the target reached at resume time, no pass rendered, the same map.
+    const std::vector<float> first = report.noise_map;
+    const double first_noise = report.noise;
+    report = MonteCarloReport();
+    request.resume = true;
+    const int before = model.passes_rendered;
+    Image resumed;
+    model.Render(request, &resumed);
+    EXPECT_EQ(model.passes_rendered, before);
+    EXPECT_EQ(report.noise, first_noise);
+    EXPECT_EQ(report.noise_map, first);
+    EXPECT_EQ(std::memcmp(resumed.data(), image.data(), image.size() * sizeof(float)), 0);
+}
+
+}  // namespace
+}  // namespace atmos

@@ -155,6 +155,10 @@ struct MonteCarloSettings {
 struct MonteCarloReport {
     int64_t samples = 0;  // paths per pixel in the image
     double noise = -1.0;  // HDR-FLIP between its two halves; < 0: not measured
+    // The per-pixel HDR-FLIP map of the two halves at the measurement that gave
+    // `noise` (width x height, row-major, top row first; its mean is `noise`);
+    // empty when the noise was not measured.
+    std::vector<float> noise_map;
 };
 
 // One pass of a Monte Carlo model: the mean of samples [first_sample,

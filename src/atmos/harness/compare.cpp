@@ -468,7 +468,17 @@ CompareResult RunCompare(const CompareConfig& config) {
             ref = reference.Render(view, &row.reference_seconds, &row.reference_cached, &ref_report,
                                    &ref_variance);
             row.reference_spp = ref_report.samples;
-            if (noise_target) row.reference_noise = ref_report.noise;
+            if (noise_target) {
+                row.reference_noise = ref_report.noise;
+                // The halves' FLIP map at the render's last measurement (its
+                // mean is reference_noise), over each region as for a split
+                // reference; a spectral reference has none (whole-image noise).
+                if (!ref_report.noise_map.empty()) {
+                    const RegionValues noise = RegionMean(ref_report.noise_map, mask);
+                    row.reference_noise_sky = std::isfinite(noise.sky) ? noise.sky : -1.0;
+                    row.reference_noise_ground = std::isfinite(noise.ground) ? noise.ground : -1.0;
+                }
+            }
         }
         if (split_reference && !from_shipped) {
             double seconds_b = 0.0;

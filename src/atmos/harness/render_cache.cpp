@@ -2,10 +2,13 @@
 #include "harness/render_cache.h"
 
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <vector>
 
 #include "atmos/error.h"
 #include "base/fnv1a.h"
@@ -15,14 +18,46 @@ namespace fs = std::filesystem;
 
 namespace atmos {
 
+namespace {
+
+std::string Hex64(std::uint64_t h) {
+    char text[17];
+    std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(h));
+    return std::string(text);
+}
+
+// A noise-targeted render's per-pixel noise map (MonteCarloReport::noise_map)
+// beside its image: STEM.noise-map.bin, width x height float32 in host byte
+// order, its FNV-1a hash in the entry's JSON ("noise_map").
+std::string NoiseMapPath(const std::string& exr) {
+    return exr.substr(0, exr.size() - 4) + ".noise-map.bin";
+}
+
+// The map of an entry; false when absent, damaged (size, hash) or not a
+// FLIP map (every value finite, in [0, 1]).
+bool ReadNoiseMap(const std::string& path, const std::string& hash, size_t pixels,
+                  std::vector<float>* map) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return false;
+    std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    if (bytes.size() != pixels * sizeof(float)) return false;
+    if (Hex64(Fnv1a(bytes.data(), bytes.size())) != hash) return false;
+    std::vector<float> values(pixels);
+    std::memcpy(values.data(), bytes.data(), bytes.size());
+    for (float v : values) {
+        if (!(v >= 0.0f && v <= 1.0f)) return false;
+    }
+    *map = std::move(values);
+    return true;
+}
+
+}  // namespace
+
 std::string BuildIdentity() {
     static const std::string identity = [] {
         std::ifstream exe("/proc/self/exe", std::ios::binary);
         if (!exe) return std::string("unknown");
-        const std::uint64_t h = Fnv1aStream(exe);
-        char text[17];
-        std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(h));
-        return std::string(text);
+        return Hex64(Fnv1aStream(exe));
     }();
     return identity;
 }
@@ -83,6 +118,20 @@ bool RenderCache::Load(const RenderKey& key, Image* image, double* render_second
         if (report) {
             report->samples = j.value("samples", static_cast<int64_t>(0));
             report->noise = j.value("noise", -1.0);
+            report->noise_map.clear();
+            // A noise-targeted render's measured noise comes with its map: an
+            // entry without one (written before atmos stored it) or with a
+            // damaged one is a miss, re-rendered, so that a cached run gives
+            // the region noise an uncached one gives.
+            if (key.monte_carlo && key.mc.noise_target > 0.0 && report->noise >= 0.0) {
+                if (!j.contains("noise_map")) return false;
+                const size_t pixels =
+                    static_cast<size_t>(key.width) * static_cast<size_t>(key.height);
+                if (!ReadNoiseMap(NoiseMapPath(exr), j.at("noise_map").get<std::string>(), pixels,
+                                  &report->noise_map)) {
+                    return false;
+                }
+            }
         }
         if (variance) {
             *variance = Image();
@@ -115,6 +164,13 @@ void RenderCache::Store(const RenderKey& key, const Image& image, double render_
     if (variance && variance->width() == image.width() && variance->height() == image.height()) {
         WriteImage(*variance, exr.substr(0, exr.size() - 4) + ".variance.exr");
         j["variance"] = true;
+    }
+    if (report && !report->noise_map.empty() &&
+        report->noise_map.size() == static_cast<size_t>(image.width()) * image.height()) {
+        std::string bytes(report->noise_map.size() * sizeof(float), '\0');
+        std::memcpy(bytes.data(), report->noise_map.data(), bytes.size());
+        WriteFileAtomically(NoiseMapPath(exr), bytes);
+        j["noise_map"] = Hex64(Fnv1a(bytes.data(), bytes.size()));
     }
     WriteFileAtomically(meta, j.dump(1) + "\n");
 }

@@ -47,7 +47,9 @@ class RenderCache {
     explicit RenderCache(std::string directory);
     bool enabled() const { return !directory_.empty(); }
     // Loads the image and the seconds its render took; false when absent or stale.
-    // A Monte Carlo render's report (reached noise, paths) travels with it.
+    // A Monte Carlo render's report (reached noise, paths) travels with it,
+    // and a noise-targeted render's per-pixel noise map (noise_map; an entry
+    // whose measured noise has no valid map is a miss).
     // A Monte Carlo render's per-pixel variance, when stored with it, is
     // loaded into `variance` (left empty when absent).
     bool Load(const RenderKey& key, Image* image, double* render_seconds,

@@ -137,6 +137,8 @@ std::vector<SpectralImage> RenderSpectralRequests(
                 if (reports) {
                     MonteCarloReport& total = (*reports)[v];
                     total.samples += report.samples;
+                    // The per-pixel noise map stays empty: a batch's map is
+                    // of its own wavelengths, not of the colour image.
                     total.noise = std::max(total.noise, report.noise);
                 }
                 const size_t pixels = static_cast<size_t>(r.width) * r.height;

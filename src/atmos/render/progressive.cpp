@@ -535,6 +535,7 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     // A noise target: the halves' FLIP after pairs of passes, at sample counts
     // growing geometrically (or as FLIP ~ spp^-0.45 predicts, at most x3).
     double noise = -1.0;
+    std::vector<float> noise_map;  // its per-pixel map (MonteCarloReport::noise_map)
     int64_t next_check = 0;
     auto measure_noise = [&]() {
         const int64_t half = samples_done / 2;  // even and odd halves hold the same count
@@ -544,7 +545,9 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
             a.data()[i] = state.sum_even.data()[i] * inv_half;
             b.data()[i] = (sum.data()[i] - state.sum_even.data()[i]) * inv_half;
         }
-        noise = HdrFlip(a, b).mean;
+        FlipResult halves = HdrFlip(a, b);
+        noise = halves.mean;
+        noise_map = std::move(halves.map);
         if (request.show_progress) {
             std::fprintf(stderr, "%s: %lld paths per pixel, noise %.4f (target %.4f)\n",
                          model.Info().name.c_str(), static_cast<long long>(samples_done), noise,
@@ -679,6 +682,7 @@ void RenderProgressive(const Model& model, const RenderRequest& request, Image* 
     if (request.report) {
         request.report->samples = samples_done;
         request.report->noise = noise;
+        request.report->noise_map = std::move(noise_map);
     }
     if (shard) {
         // The shard's passes, not an image (MergeShards makes it).

@@ -295,6 +295,7 @@ void MergeShards(const std::vector<ShardFile>& files, const std::vector<std::str
     if (report) {
         report->samples = samples;
         report->noise = -1.0;
+        report->noise_map.clear();
         if (passes >= 2) {
             // The HDR-FLIP between the means of the even and the odd passes,
             // the measure of `render --noise` (informational here).
@@ -305,7 +306,9 @@ void MergeShards(const std::vector<ShardFile>& files, const std::vector<std::str
                 a.data()[i] = sum_even.data()[i] * inv_even;
                 b.data()[i] = std::max(sum.data()[i] - sum_even.data()[i], 0.0f) * inv_odd;
             }
-            report->noise = HdrFlip(a, b).mean;
+            FlipResult halves = HdrFlip(a, b);
+            report->noise = halves.mean;
+            report->noise_map = std::move(halves.map);
         }
     }
 }

@@ -129,7 +129,7 @@ std::vector<int64_t> ShardPasses(int64_t passes, int64_t index, int64_t count,
 // the variance of its mean) exactly as the one-process render makes them;
 // report->samples gets the paths per pixel and report->noise the HDR-FLIP
 // between the means of the even and the odd passes (the measure of a noise
-// target; -1 with one pass).
+// target; -1 with one pass) and report->noise_map its per-pixel map.
 void MergeShards(const std::vector<ShardFile>& files, const std::vector<std::string>& names,
                  Image* out, Image* variance, MonteCarloReport* report);
 
