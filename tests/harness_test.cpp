@@ -22,6 +22,7 @@
 #include "harness/loc.h"
 #include "harness/render_cache.h"
 #include "harness/shipped_references.h"
+#include "harness/table_cache.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;
@@ -120,9 +121,9 @@ TEST(RenderCache, RoundTripAndKeying) {
     EXPECT_FALSE(RenderCache("").Load(key, &loaded, &seconds));
     // An image another build stored (same key otherwise) is not reused: edit the
     // stored key text's build line as an older executable would have written it.
-    const std::string id = BuildIdentity();
+    const std::string id = CodeIdentity();
     EXPECT_EQ(id.size(), 16u);
-    EXPECT_EQ(id, BuildIdentity());
+    EXPECT_EQ(id, CodeIdentity());
     EXPECT_NE(RenderKeyText(key).find("build " + id + "\n"), std::string::npos);
     const fs::path meta = fs::path(cache.ImagePath(key)).replace_extension(".json");
     ASSERT_TRUE(fs::exists(meta)) << meta;

@@ -12,6 +12,7 @@
 
 #include "atmos/error.h"
 #include "base/fnv1a.h"
+#include "harness/table_cache.h"
 #include "io/output_path.h"
 
 namespace fs = std::filesystem;
@@ -53,19 +54,10 @@ bool ReadNoiseMap(const std::string& path, const std::string& hash, size_t pixel
 
 }  // namespace
 
-std::string BuildIdentity() {
-    static const std::string identity = [] {
-        std::ifstream exe("/proc/self/exe", std::ios::binary);
-        if (!exe) return std::string("unknown");
-        return Hex64(Fnv1aStream(exe));
-    }();
-    return identity;
-}
-
 std::string RenderKeyText(const RenderKey& key) {
     std::ostringstream os;
     os << "atmos-render-cache 2\n";
-    os << "build " << BuildIdentity() << "\n";
+    os << "build " << CodeIdentity() << "\n";
     os << "model " << key.model << "\n";
     for (const auto& [name, value] : key.options) os << "option " << name << "=" << value << "\n";
     if (key.monte_carlo) {

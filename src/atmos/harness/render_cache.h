@@ -5,9 +5,10 @@
 // view's name, the size and the quantity. The key text is hashed (FNV-1a, 64
 // bit) into the file name; the key text itself is stored beside the image and
 // compared on load, so a hash collision can never return a wrong image. The
-// key also holds the running executable's hash (BuildIdentity), so a rebuilt
-// atmos (changed model code, new embedded neural weights or presets) never
-// reuses an image an older build rendered; `--no-cache` skips the cache.
+// key also holds the code's hash (CodeIdentity: the executable, or the Python
+// module), so a rebuilt atmos (changed model code, new embedded neural weights
+// or presets) never reuses an image an older build rendered; `--no-cache`
+// skips the cache.
 #pragma once
 
 #include <cstdint>
@@ -31,10 +32,8 @@ struct RenderKey {
     MonteCarloSettings mc;
 };
 
-// A 64-bit FNV-1a hash of the running executable (/proc/self/exe), in hex;
-// "unknown" where it cannot be read. Computed once per process.
-std::string BuildIdentity();
-// The canonical key text (one line per field, the build identity included).
+// The canonical key text (one line per field, the code's identity included:
+// CodeIdentity(), harness/table_cache.h, the executable or the Python module).
 std::string RenderKeyText(const RenderKey& key);
 std::uint64_t Fnv1a64(const std::string& text);
 // The resolved options of a model (every option at its given value or default).
