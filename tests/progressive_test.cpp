@@ -346,6 +346,19 @@ TEST(Progressive, ACheckpointsSumsAreRangeChecked) {
 namespace atmos {
 namespace {
 
+// The FLIP between a coin render's first pair of passes (seed 11, 3 samples
+// each): the even pass (samples 0-2) against the odd one (3-5).
+FlipResult EvenOddFlip(const Model& model, const RenderRequest& request) {
+    Image even, odd;
+    MonteCarloPass pass;
+    pass.seed = 11;
+    pass.samples = 3;
+    model.RenderPass(request, pass, &even, nullptr);
+    pass.first_sample = 3;
+    model.RenderPass(request, pass, &odd, nullptr);
+    return HdrFlip(even, odd);
+}
+
 // A noise target: pairs of passes (even and odd: the two halves), checked as
 // they grow, stopping at the target or the spp cap; the image is the plain
 // render of the same samples, and a checkpoint (with the halves) resumes it.
@@ -371,14 +384,7 @@ TEST(Progressive, RendersToANoiseTargetOrTheCap) {
     EXPECT_EQ(report.samples, 6);
     EXPECT_LE(report.noise, 0.99);
     // The noise is the FLIP between the even pass (samples 0-2) and the odd one (3-5).
-    Image even, odd;
-    MonteCarloPass pass;
-    pass.seed = 11;
-    pass.samples = 3;
-    model.RenderPass(request, pass, &even, nullptr);
-    pass.first_sample = 3;
-    model.RenderPass(request, pass, &odd, nullptr);
-    EXPECT_NEAR(report.noise, HdrFlip(even, odd).mean, 1e-6);
+    EXPECT_NEAR(report.noise, EvenOddFlip(model, request).mean, 1e-6);
     // Resumed from a checkpoint of the first pair: the capped image again.
     const std::filesystem::path dir = TestDir("progressive_noise");
     request.monte_carlo.noise_target = 1e-6;
@@ -476,14 +482,7 @@ TEST(Progressive, ANoiseTargetReturnsTheHalvesFlipMap) {
     request.checkpoint = (dir / "coin").string();
     model.Render(request, &image);
     EXPECT_EQ(report.samples, 6);
-    Image even, odd;
-    MonteCarloPass pass;
-    pass.seed = 11;
-    pass.samples = 3;
-    model.RenderPass(request, pass, &even, nullptr);
-    pass.first_sample = 3;
-    model.RenderPass(request, pass, &odd, nullptr);
-    const FlipResult halves = HdrFlip(even, odd);
+    const FlipResult halves = EvenOddFlip(model, request);
     ASSERT_EQ(report.noise_map.size(), static_cast<size_t>(request.width * request.height));
     float sum = 0.0f;
     for (size_t i = 0; i < report.noise_map.size(); ++i) {

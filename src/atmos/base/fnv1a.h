@@ -5,7 +5,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <istream>
+#include <string>
 
 namespace atmos {
 
@@ -19,6 +21,13 @@ inline std::uint64_t Fnv1a(const char* data, std::size_t size,
         h *= 1099511628211ull;
     }
     return h;
+}
+
+// `h` as 16 lowercase hexadecimal digits (the caches' keys and checksums).
+inline std::string Fnv1aHex(std::uint64_t h) {
+    char text[17];
+    std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(h));
+    return std::string(text);
 }
 
 // The hash of the bytes of `in` to its end; *bytes (optional) their count.

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "atmos/error.h"
+#include "base/fnv1a.h"
 #include "base/parallel.h"
 #include "harness/compare_regions.h"
 #include "harness/ranking.h"
@@ -212,8 +213,7 @@ std::string CacheViewName(const View& view) {
     std::snprintf(buf, sizeof buf, "half_fov %.17g\nlimb %.17g\n", view.camera.half_fov,
                   view.sun_limb_darkening);
     text += buf;
-    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(Fnv1a64(text)));
-    return view.name + "-" + buf;
+    return view.name + "-" + Fnv1aHex(Fnv1a64(text));
 }
 
 std::string FileStem(const std::string& name) {

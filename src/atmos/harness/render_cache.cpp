@@ -21,12 +21,6 @@ namespace atmos {
 
 namespace {
 
-std::string Hex64(std::uint64_t h) {
-    char text[17];
-    std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(h));
-    return std::string(text);
-}
-
 // A noise-targeted render's per-pixel noise map (MonteCarloReport::noise_map)
 // beside its image: STEM.noise-map.bin, width x height float32 in host byte
 // order, its FNV-1a hash in the entry's JSON ("noise_map").
@@ -42,7 +36,7 @@ bool ReadNoiseMap(const std::string& path, const std::string& hash, size_t pixel
     if (!f) return false;
     std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
     if (bytes.size() != pixels * sizeof(float)) return false;
-    if (Hex64(Fnv1a(bytes.data(), bytes.size())) != hash) return false;
+    if (Fnv1aHex(Fnv1a(bytes.data(), bytes.size())) != hash) return false;
     std::vector<float> values(pixels);
     std::memcpy(values.data(), bytes.data(), bytes.size());
     for (float v : values) {
@@ -85,10 +79,8 @@ std::map<std::string, std::string> ResolvedModelOptions(
 RenderCache::RenderCache(std::string directory) : directory_(std::move(directory)) {}
 
 std::string RenderCache::ImagePath(const RenderKey& key) const {
-    char hash[17];
-    std::snprintf(hash, sizeof hash, "%016llx",
-                  static_cast<unsigned long long>(Fnv1a64(RenderKeyText(key))));
-    const std::string stem = key.model + "-" + key.view + "-" + hash;
+    const std::string stem =
+        key.model + "-" + key.view + "-" + Fnv1aHex(Fnv1a64(RenderKeyText(key)));
     return (fs::path(directory_) / (stem + ".exr")).string();
 }
 
@@ -162,7 +154,7 @@ void RenderCache::Store(const RenderKey& key, const Image& image, double render_
         std::string bytes(report->noise_map.size() * sizeof(float), '\0');
         std::memcpy(bytes.data(), report->noise_map.data(), bytes.size());
         WriteFileAtomically(NoiseMapPath(exr), bytes);
-        j["noise_map"] = Hex64(Fnv1a(bytes.data(), bytes.size()));
+        j["noise_map"] = Fnv1aHex(Fnv1a(bytes.data(), bytes.size()));
     }
     WriteFileAtomically(meta, j.dump(1) + "\n");
 }
@@ -172,10 +164,9 @@ namespace {
 std::string PreparePath(const std::string& directory, const RenderKey& key) {
     RenderKey k = key;
     k.view = "(prepare)";
-    char hash[17];
-    std::snprintf(hash, sizeof hash, "%016llx",
-                  static_cast<unsigned long long>(Fnv1a64(RenderKeyText(k))));
-    return (fs::path(directory) / (key.model + "-prepare-" + hash + ".json")).string();
+    return (fs::path(directory) /
+            (key.model + "-prepare-" + Fnv1aHex(Fnv1a64(RenderKeyText(k))) + ".json"))
+        .string();
 }
 
 }  // namespace

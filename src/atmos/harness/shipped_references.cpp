@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "atmos/error.h"
+#include "base/fnv1a.h"
 #include "harness/render_cache.h"
 #include "io/output_path.h"
 #include "models/reference.h"
@@ -97,11 +98,7 @@ T Field(const Json& j, const char* key, const std::string& where) {
 
 }  // namespace
 
-std::string HashText(const std::string& text) {
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(Fnv1a64(text)));
-    return std::string("fnv1a64:") + hex;
-}
+std::string HashText(const std::string& text) { return "fnv1a64:" + Fnv1aHex(Fnv1a64(text)); }
 
 std::string ViewFingerprintText(const View& view) {
     std::string s = "view " + view.name + "\n";

@@ -27,12 +27,6 @@ namespace {
 
 constexpr const char* kManifest = "manifest.json";
 
-std::string Hex(uint64_t h) {
-    char text[17];
-    std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(h));
-    return text;
-}
-
 uint64_t HashText(const std::string& text) {
     std::istringstream in(text);
     return Fnv1aStream(in, nullptr);
@@ -42,7 +36,7 @@ uint64_t HashText(const std::string& text) {
 bool HashFile(const fs::path& path, int64_t* bytes, std::string* checksum) {
     std::ifstream in(path, std::ios::binary);
     if (!in) return false;
-    *checksum = Hex(Fnv1aStream(in, bytes));
+    *checksum = Fnv1aHex(Fnv1aStream(in, bytes));
     return true;
 }
 
@@ -137,7 +131,7 @@ std::string CodeIdentity() {
         }
         std::ifstream in(path, std::ios::binary);
         if (!in) return std::string("unknown");
-        return Hex(Fnv1aStream(in, nullptr));
+        return Fnv1aHex(Fnv1aStream(in, nullptr));
     }();
     return identity;
 }
@@ -202,7 +196,7 @@ TablePrepareResult PrepareWithTableCache(Model* model,
     }
     const std::string key = TableCacheKeyText(*model, given, atmosphere);
     const fs::path root(settings.directory);
-    const fs::path entry = root / (model->Info().name + "-" + Hex(HashText(key)));
+    const fs::path entry = root / (model->Info().name + "-" + Fnv1aHex(HashText(key)));
     result.entry = entry.string();
     std::error_code ec;
     if (fs::exists(entry / kManifest, ec)) {
@@ -230,7 +224,7 @@ TablePrepareResult PrepareWithTableCache(Model* model,
     prepare();
     // Store: bake into a temporary directory, add the manifest, rename into place.
     std::mt19937_64 rng(std::random_device{}());
-    const fs::path tmp = root / (".tmp-" + Hex(rng()) + "-" + std::to_string(getpid()));
+    const fs::path tmp = root / (".tmp-" + Fnv1aHex(rng()) + "-" + std::to_string(getpid()));
     try {
         fs::create_directories(tmp);
         model->Bake(tmp.string());
