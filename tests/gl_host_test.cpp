@@ -2,9 +2,10 @@
 // host examples/gl_host renders views of a bake headless through EGL (Mesa's
 // llvmpipe here), and each must match `atmos render --load` of the same view
 // from the same tables: mean HDR-FLIP <= 0.01. bruneton (small tables, separate
-// Mie), hillaire (its baked tables and the host's per-frame sky-view and
-// aerial-perspective passes) and atmosphere-plus (small tables), at standard
-// views and a free camera, float32 and float16 blobs. Skipped with the reason
+// and combined Mie), hillaire (its baked tables and the host's per-frame
+// sky-view and aerial-perspective passes), atmosphere-plus (small tables) and
+// hosek-wilkie (no tables), at four standard views and a free camera with
+// float32 tables and one view with float16 tables. Skipped with the reason
 // where the host was not built (no EGL/OpenGL at configure time) or EGL gives
 // no OpenGL 3.3 context, and in sanitizer builds.
 #include <gtest/gtest.h>
@@ -111,6 +112,13 @@ TEST(GlHost, BrunetonMatchesAtmosRender) {
         "bruneton", "bruneton:orders=2:scattering-r=16:scattering-mu=64:scattering-mu-s=16");
 }
 
+TEST(GlHost, BrunetonCombinedMieMatchesAtmosRender) {
+    // One RGBA scattering table, the single Mie extrapolated from its alpha.
+    ExpectHostMatchesAtmosRender("bruneton-combined",
+                                 "bruneton:orders=2:scattering-r=16:scattering-mu=64:scattering-"
+                                 "mu-s=16:mie-storage=combined");
+}
+
 TEST(GlHost, HillaireMatchesAtmosRender) { ExpectHostMatchesAtmosRender("hillaire", "hillaire"); }
 
 TEST(GlHost, AtmospherePlusMatchesAtmosRender) {
@@ -118,6 +126,11 @@ TEST(GlHost, AtmospherePlusMatchesAtmosRender) {
         "atmosphere-plus",
         "atmosphere-plus:orders=2:table-width=16:table-height=32:table-depth=16:"
         "transmittance-width=16:transmittance-height=64:gather-theta=6:gather-phi=12");
+}
+
+TEST(GlHost, HosekWilkieMatchesAtmosRender) {
+    // No tables: constants only (an empty blob).
+    ExpectHostMatchesAtmosRender("hosek-wilkie", "hosek-wilkie");
 }
 
 // Bad input: one `atmos_gl_host: error: ...` line, exit 2, nothing written
