@@ -486,9 +486,27 @@ struct Renderer {
 // ATMOS_AP_SIZE^3 (constants of the model's file, not of the bake).
 constexpr int kSkyViewWidth = 192, kSkyViewHeight = 108, kApSize = 32;
 
+// Every active sampler of `program` must be one of `names` (given a texture
+// unit): an unbound sampler would silently read unit 0.
+void RequireSamplers(GLuint program, const std::vector<std::string>& names) {
+    GLint count = 0;
+    glGetProgramiv(program, GL_ACTIVE_UNIFORMS, &count);
+    for (GLint i = 0; i < count; ++i) {
+        char name[256];
+        GLint size = 0;
+        GLenum type = 0;
+        glGetActiveUniform(program, static_cast<GLuint>(i), sizeof name, nullptr, &size, &type,
+                           name);
+        const bool is_sampler = type == GL_SAMPLER_2D || type == GL_SAMPLER_3D;
+        if (is_sampler && std::find(names.begin(), names.end(), name) == names.end()) {
+            throw Error(std::string("no table for the shader's sampler ") + name);
+        }
+    }
+}
+
 // Texture units of a program: every baked table whose sampler the program
 // declares; then the frame tables. A sampler left without a table is an error
-// (a model this host does not know).
+// (a model this host does not know: add it to kBakedSamplers).
 void BindBakedTables(Renderer* r, const Bake& bake, GLuint program) {
     glUseProgram(program);
     const Json& tables = bake.json["raw"]["tables"];
@@ -521,21 +539,9 @@ void BindBakedTables(Renderer* r, const Bake& bake, GLuint program) {
             r->units.push_back({f.sampler, f.target, f.texture});
         }
     }
-    // Every active sampler must have a table.
-    GLint count = 0;
-    glGetProgramiv(program, GL_ACTIVE_UNIFORMS, &count);
-    for (GLint i = 0; i < count; ++i) {
-        char name[256];
-        GLint size = 0;
-        GLenum type = 0;
-        glGetActiveUniform(program, static_cast<GLuint>(i), sizeof name, nullptr, &size, &type,
-                           name);
-        const bool has_table = std::any_of(r->units.begin(), r->units.end(),
-                                           [&](const Bound& b) { return b.sampler == name; });
-        if ((type == GL_SAMPLER_2D || type == GL_SAMPLER_3D) && !has_table) {
-            throw Error(std::string("no table for the shader's sampler ") + name);
-        }
-    }
+    std::vector<std::string> names;
+    for (const Bound& b : r->units) names.push_back(b.sampler);
+    RequireSamplers(program, names);
     CheckGl("BindBakedTables");
 }
 
@@ -552,6 +558,10 @@ void MakeFramePasses(Renderer* r, const Bake& bake) {
     }
     glUniform1i(Uniform(r->ap_pass, "u_prev_scatter"), 2);
     glUniform1i(Uniform(r->ap_pass, "u_prev_transmittance"), 3);
+    RequireSamplers(r->sky_view_pass,
+                    {"atmos_transmittance_texture", "atmos_multiple_scattering_texture"});
+    RequireSamplers(r->ap_pass, {"atmos_transmittance_texture", "atmos_multiple_scattering_texture",
+                                 "u_prev_scatter", "u_prev_transmittance"});
     for (const Bound& b : r->units) {
         if (b.sampler == "atmos_transmittance_texture") r->baked_units[0] = b.texture;
         if (b.sampler == "atmos_multiple_scattering_texture") r->baked_units[1] = b.texture;
