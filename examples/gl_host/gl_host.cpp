@@ -28,6 +28,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -257,12 +258,20 @@ struct Bake {
     std::string glsl;   // the "order" files concatenated
 };
 
-Bake LoadBake(const std::string& dir, const std::string& model, bool half) {
+// The bake's NAME.json is the JSON file of DIR with "model", "raw" and
+// "shaders" (DIR may also hold tables_rgba.json, which has no "shaders").
+Bake LoadBake(const std::string& dir, bool half) {
     Bake b;
-    b.json = Json::parse(ReadFile(dir + "/" + model + ".json"));
-    if (!b.json.contains("raw") || !b.json.contains("shaders")) {
-        throw Error(dir + "/" + model + ".json has no \"raw\" tables or \"shaders\"");
+    std::error_code error;
+    for (const auto& file : std::filesystem::directory_iterator(dir, error)) {
+        if (file.path().extension() != ".json") continue;
+        Json j = Json::parse(ReadFile(file.path().string()), nullptr, false);
+        if (j.is_object() && j.contains("model") && j.contains("raw") && j.contains("shaders")) {
+            b.json = std::move(j);
+            break;
+        }
     }
+    if (b.json.is_null()) throw Error("no bake in '" + dir + "' (atmos bake --model NAME -o DIR)");
     b.half = half;
     b.blob = ReadFile(dir + "/" +
                       b.json["raw"][half ? "float16" : "float32"]["file"].get<std::string>());
@@ -747,17 +756,8 @@ int Run(int argc, char** argv) {
     if (view_name.empty() == camera.empty()) throw Error("give --view NAME or --camera SPEC");
     if (!camera.empty() && sun.empty()) throw Error("--camera needs --sun elevation=DEG");
 
-    // The model's name: the one NAME.json of the bake with "raw" and "shaders"
-    // is found through atmos bake's convention of naming it after the model.
-    std::string model;
-    for (const char* name : {"bruneton", "hillaire", "atmosphere-plus", "hosek-wilkie"}) {
-        if (std::ifstream(dir + "/" + name + ".json")) {
-            model = name;
-            break;
-        }
-    }
-    if (model.empty()) throw Error("no bake in '" + dir + "' (atmos bake --model NAME -o DIR)");
-    const Bake bake = LoadBake(dir, model, format == "f16");
+    const Bake bake = LoadBake(dir, format == "f16");
+    const std::string model = bake.json["model"];
     Renderer r;
     r.bottom = bake.json["atmosphere"]["bottom_radius"];
     r.top = bake.json["atmosphere"]["top_radius"];
