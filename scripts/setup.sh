@@ -20,11 +20,14 @@ fi
 # (The viewer test also renders `atmos viewer`'s page there: WebGL2 on SwiftShader.)
 # python3-*, pybind11-dev: the Python module (import atmos, python/) and its
 # pytest suite, built for Debian's /usr/bin/python3; matplotlib: examples/.
+# libegl-dev .. libgl1-mesa-dri: the OpenGL 3.3 host examples/gl_host, headless
+# through EGL (Mesa's llvmpipe runs it on the CPU in its test, GlHost.*).
 packages=(cmake g++ make ninja-build pkg-config libopenexr-dev libpng-dev nlohmann-json3-dev
           libcli11-dev libnlopt-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev clang-format
           chromium fonts-dejavu-core
           python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-matplotlib
-          python3-ephem glslang-tools spirv-cross spirv-tools libopenmpi-dev openmpi-bin)
+          python3-ephem glslang-tools spirv-cross spirv-tools libopenmpi-dev openmpi-bin
+          libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
