@@ -99,7 +99,8 @@ std::string WriteTempFile(const std::string& name, const std::string& text) {
 
 TEST(Atmosphere, PresetNamesListTheShippedFiles) {
     const std::vector<std::string> names = AtmospherePresetNames();
-    for (const char* expected : {"earth", "earth-bruneton", "earth-atmosphere-plus", "mars"}) {
+    for (const char* expected :
+         {"earth", "earth-bruneton", "earth-atmosphere-plus", "mars", "titan", "venus"}) {
         EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
     }
 }
