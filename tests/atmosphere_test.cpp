@@ -99,7 +99,8 @@ std::string WriteTempFile(const std::string& name, const std::string& text) {
 
 TEST(Atmosphere, PresetNamesListTheShippedFiles) {
     const std::vector<std::string> names = AtmospherePresetNames();
-    for (const char* expected : {"earth", "earth-bruneton", "earth-atmosphere-plus", "mars"}) {
+    for (const char* expected :
+         {"earth", "earth-bruneton", "earth-atmosphere-plus", "mars", "titan", "venus"}) {
         EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
     }
 }
@@ -195,6 +196,79 @@ TEST(Atmosphere, PresetsHaveTheirDocumentedValues) {
     // Vertical dust optical depth about 0.5.
     EXPECT_NEAR(mars.mie_extinction[0] * 11100.0, 0.5, 0.01);
     EXPECT_LT(mars.mie_scattering[2], mars.mie_scattering[0]);
+}
+
+// The vertical optical depth of one constituent from altitude h0 to the top
+// (midpoint rule on 1 m steps: the profiles vary on kilometres).
+double VerticalDepth(const AtmosphereParameters& a, const DensityProfile& p, double coefficient,
+                     double h0 = 0.0) {
+    const double top = a.top_radius - a.bottom_radius;
+    double sum = 0.0;
+    for (double h = h0 + 0.5; h < top; h += 1.0) sum += ProfileDensity(p, h);
+    return sum * coefficient;
+}
+
+// Issue 32 item 5: the Titan-like and Venus-like presets. Their Rayleigh
+// columns are checked against hydrostatics (column number p_s / (m g), from
+// the surface pressures, molar masses and gravities of the sources cited in
+// the files) times the cited cross-sections, not against the profiles'
+// own arithmetic; their profiles are continuous at the layer boundary.
+TEST(Atmosphere, ThickPresetsHaveTheirDocumentedOpticalDepths) {
+    constexpr double kAmu = 1.66053907e-27;
+    const auto sigma = [](double sigma532, double nm) {
+        return sigma532 * std::pow(532.0 / nm, 4);
+    };
+    const double nm[3] = {680.0, 550.0, 440.0};
+    const auto continuous = [](const DensityProfile& p) {
+        const double w = p.layers[0].width;
+        EXPECT_NEAR(LayerDensity(p.layers[0], w), LayerDensity(p.layers[1], w), 1e-9) << w;
+    };
+
+    const AtmosphereParameters titan = LoadAtmosphere("titan");
+    EXPECT_EQ(titan.bottom_radius, 2574.73e3);
+    EXPECT_EQ(titan.top_radius - titan.bottom_radius, 600e3);
+    continuous(titan.rayleigh_density);
+    continuous(titan.mie_density);
+    // Huygens HASI: 1467 hPa, gravity 1.352 m/s^2; N2 (28.0134 u), 5.1e-31 m^2 at 532 nm.
+    const double titan_column = 1.467e5 / (28.0134 * kAmu * 1.352);
+    const double haze[3] = {3.18, 4.28, 5.85};  // 4.5 (nm / 531)^-1.4
+    const double haze_albedo[3] = {0.95, 0.90, 0.80};
+    for (int c = 0; c < 3; ++c) {
+        SCOPED_TRACE(c);
+        EXPECT_NEAR(VerticalDepth(titan, titan.rayleigh_density, titan.rayleigh_scattering[c]),
+                    titan_column * sigma(5.1e-31, nm[c]),
+                    0.005 * titan_column * sigma(5.1e-31, nm[c]));
+        EXPECT_NEAR(VerticalDepth(titan, titan.mie_density, titan.mie_extinction[c]), haze[c],
+                    0.01);
+        EXPECT_NEAR(titan.mie_scattering[c] / titan.mie_extinction[c], haze_albedo[c], 1e-4);
+    }
+    EXPECT_EQ(MaxComponent(titan.absorption_extinction), 0.0);
+
+    const AtmosphereParameters venus = LoadAtmosphere("venus");
+    EXPECT_EQ(venus.bottom_radius, 6051.8e3);
+    EXPECT_EQ(venus.top_radius - venus.bottom_radius, 100e3);
+    continuous(venus.rayleigh_density);
+    continuous(venus.mie_density);
+    // VIRA: 92.1 bar, 43.44 u, gravity 8.87 m/s^2; CO2 1.24e-30 m^2 at 532 nm.
+    // The two exponentials keep the column within 4 %.
+    const double venus_column = 9.21e6 / (43.44 * kAmu * 8.87);
+    for (int c = 0; c < 3; ++c) {
+        SCOPED_TRACE(c);
+        const double want = venus_column * sigma(1.24e-30, nm[c]);
+        const double got =
+            VerticalDepth(venus, venus.rayleigh_density, venus.rayleigh_scattering[c]);
+        EXPECT_LT(got, want);
+        EXPECT_GT(got, 0.96 * want);
+        // Clouds: 30 in all, 1 above 70 km (the cloud top), none below 47.5 km.
+        EXPECT_NEAR(VerticalDepth(venus, venus.mie_density, venus.mie_extinction[c]), 30.0, 0.01);
+        EXPECT_NEAR(VerticalDepth(venus, venus.mie_density, venus.mie_extinction[c], 70e3), 1.0,
+                    0.15);
+    }
+    EXPECT_EQ(ProfileDensity(venus.mie_density, 47.4e3), 0.0);
+    EXPECT_EQ(ProfileDensity(venus.mie_density, 50e3), 1.0);
+    // VIRA's densities relative to the surface at 60 and 70 km: 0.00724, 0.00129.
+    EXPECT_NEAR(ProfileDensity(venus.rayleigh_density, 60e3), 0.00724, 0.2 * 0.00724);
+    EXPECT_NEAR(ProfileDensity(venus.rayleigh_density, 70e3), 0.00129, 0.2 * 0.00129);
 }
 
 TEST(Atmosphere, JsonRoundTripIsExact) {

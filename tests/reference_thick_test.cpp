@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "atmos/atmosphere.h"
@@ -434,6 +435,80 @@ void ExpectEstimatorsAgree(int atmospheres, uint64_t seed) {
         order1_bad, order1, beyond, compared);
     EXPECT_EQ(order1_bad, 0);
     EXPECT_LE(beyond, std::max(1, compared / 30));
+}
+
+// Issue 32 item 5: the thick presets at a few rays each (ground at noon and
+// near sunset, in the air, from space): order 1 of the hybrid against the
+// brute-force quadrature (1e-2), all orders of hybrid and tracking within 4.5
+// combined standard errors of 20 batch means each (tracking with twice the
+// paths; under normal means a false alarm about once in 5e4 rays, but the
+// paths' weights are heavy-tailed here: at 20 x 16 paths two rays sat 2-2.5
+// standard errors off values that 65,536 paths of each estimator agree on). On
+// `venus` the orders stop at 8: the paths' Russian roulette (survival 0.95
+// per vertex from the 4th, reference_tracking.h) makes the hundreds of
+// vertices a path needs to cross its clouds (optical depth 30) so rare and
+// so heavy that batch means of all orders are not normal at any affordable
+// count (docs/atmosphere.md, "Thick presets"); up to order 8 the weights grow
+// at most 1.3x. Below the clouds orders <= 8 are ~0, so the Venus rays are
+// above or inside them.
+void ExpectEstimatorsAgreeOnThickPresets(int paths_per_batch) {
+    struct Case {
+        const char* preset;
+        int max_order;
+        double altitude, mu, mu_s;
+    };
+    const Case cases[] = {
+        {"titan", 0, 0.0, 1.0, 1.0},     // ground, zenith, noon
+        {"titan", 0, 0.0, 0.05, 0.1},    // ground, near the horizon, sun 6 deg up
+        {"titan", 0, 150e3, -0.3, 0.5},  // in the haze, looking down
+        {"titan", 0, 900e3, -0.6, 0.8},  // from space (inside the 600 km shell's reach)
+        {"venus", 8, 60e3, 0.2, 0.6},    // inside the upper cloud
+        {"venus", 8, 75e3, 0.0, 0.1},    // above the cloud top, horizontal, sun low
+        {"venus", 8, 200e3, -1.0, 1.0},  // from space, nadir, noon
+        {"venus", 8, 200e3, -0.3, 0.4},  // from space, oblique
+    };
+    int compared = 0;
+    for (const Case& k : cases) {
+        const AtmosphereParameters atm = LoadAtmosphere(k.preset);
+        const ReferenceEvaluator hybrid = Prepared(atm, ReferenceEstimator::kHybrid, k.max_order);
+        const ReferenceEvaluator tracking =
+            Prepared(atm, ReferenceEstimator::kTracking, k.max_order);
+        const Ray r = QueryRay(atm, k.altitude, k.mu, k.mu_s);
+        const Vec3d want = BruteOrder1(atm, r);
+        const Vec3d got = Order1(hybrid, r);
+        Vec3d mh, sh, mt, st;
+        const uint64_t key = static_cast<uint64_t>(compared);
+        Estimate(hybrid, r, 20, paths_per_batch, key, &mh, &sh);
+        Estimate(tracking, r, 20, 2 * paths_per_batch, key, &mt, &st);
+        for (int c = 0; c < 3; ++c) {
+            SCOPED_TRACE(std::string(k.preset) + " altitude " + std::to_string(k.altitude) +
+                         " mu " + std::to_string(k.mu) + " mu_s " + std::to_string(k.mu_s) +
+                         " channel " + std::to_string(c));
+            EXPECT_NEAR(got[c], want[c], 1e-2 * want[c] + 1e-9);
+            const double se = std::hypot(sh[c], st[c]);
+            EXPECT_NEAR(mh[c], mt[c], 4.5 * se + 1e-9) << "hybrid " << mh[c] << " +- " << sh[c]
+                                                       << ", tracking " << mt[c] << " +- " << st[c];
+            // Not vacuous: multiple scattering is a visible part of the answer.
+            if (c == 1) {
+                EXPECT_GT(mh[c], 1.2 * got[c]) << "order 1 " << got[c];
+            }
+        }
+        std::printf(
+            "%s alt %.0f mu %.2f mu_s %.2f: order 1 %.5g (brute %.5g), hybrid %.5g +- %.2g, "
+            "tracking %.5g +- %.2g (green)\n",
+            k.preset, k.altitude, k.mu, k.mu_s, got.y, want.y, mh.y, sh.y, mt.y, st.y);
+        ++compared;
+    }
+    EXPECT_EQ(compared, 8);
+}
+
+TEST(ReferenceThick, EstimatorsAgreeOnTheThickPresets) {
+    ExpectEstimatorsAgreeOnThickPresets(128);  // ~6 s CPU, mostly the brute-force order 1
+}
+
+TEST(ReferenceThickSlow, EstimatorsAgreeOnTheThickPresets) {
+    if (!std::getenv("ATMOS_REFERENCE_SLOW")) GTEST_SKIP() << "ctest -L slow runs it";
+    ExpectEstimatorsAgreeOnThickPresets(2048);  // ~1 min CPU
 }
 
 TEST(ReferenceThick, EstimatorsAgreeOnRandomAtmospheres) {
