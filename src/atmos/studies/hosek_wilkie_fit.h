@@ -4,23 +4,28 @@
 // The nine-parameter form F(theta, gamma) of Hosek & Wilkie 2012 (eq. 8-9) and
 // its radiance scale L_M, each a quintic Bezier of six control points over
 // x = (elevation / (pi/2))^(1/3) (the authors' structure), fitted per channel to
-// a reference model's radiance at ground views:
+// a reference model's radiance at ground views, in relative error (m / y - 1):
 //   samples: K sun elevations at x_k = (k + 1) / K (elevation 90 deg x_k^3, so
-//     denser near the horizon as the Bezier's own parameter is), and per
+//     denser near the horizon, as the Bezier's own parameter is), and per
 //     elevation a grid of views stratified in solid angle: cos(theta) at the
 //     midpoints of Z strata of [0, 1], azimuth from the sun at the midpoints of
 //     A strata of [0, 180] deg (the sky is symmetric about the sun's vertical);
-//   1. per elevation, L_M fixed to the grid's mean radiance (the sky's mean over
-//     the hemisphere) and the nine parameters fitted by Levenberg-Marquardt in
-//     relative error (m / y - 1), from the published RGB coefficients (T = 3,
-//     albedo 0) and from the neighbouring elevation's answer, the better kept;
-//   2. each parameter's six control points by linear least squares over the
-//     elevations (L_M in relative error);
-//   3. all 60 control points of a channel refined jointly by Levenberg-Marquardt
-//     on every sample's relative error (L_M kept >= 0).
-// The objective is the relative RMSE over the sky, the figure reported. The fit
-// is serial and the reference's answers do not depend on the thread count, so
-// the coefficients are the same bytes for any --threads.
+//     so the objective is the relative RMSE over the sky;
+//   1. per elevation (from the zenith sun down), L_M fixed to the grid's mean
+//     radiance and the nine parameters fitted by Levenberg-Marquardt, from the
+//     published RGB coefficients (T = 3, albedo 0) and from the neighbouring
+//     elevation's answer (kept unless the published start is twice as good);
+//   2. A, B, E, H: their six control points by linear least squares over the
+//     elevations; L_M and C, D, F, G, I, which enter the form only as the
+//     products L_M C, ..., L_M I: alternating least squares for quintics whose
+//     products match stage 1's;
+//   3. all 60 control points of a channel by Levenberg-Marquardt on every
+//     sample, from stage 2 and from the published points (L_M scaled by the
+//     data's best factor); at each trial point the 30 control points of
+//     C, D, F, G, I, in which the form is linear once the others are fixed,
+//     are solved for exactly, and L_M's are kept >= 0; the better end is kept.
+// The fit is serial and the reference's answers do not depend on the thread
+// count, so the coefficients are the same bytes for any --threads.
 #pragma once
 
 #include <string>
@@ -39,8 +44,8 @@ struct HosekWilkieFitConfig {
     int view_zeniths = 16;                     // Z, in [4, 256]
     int view_azimuths = 24;                    // A, in [4, 512]
     int iterations = 200;  // Levenberg-Marquardt iterations per stage, in [1, 10000]
-    // Also sample the grid shifted by half a stratum in every coordinate (and
-    // elevations between the fitted ones) and report the fit's error there.
+    // Also sample the points halfway between the grid's (in elevation's x,
+    // cos(theta) and azimuth) and report the fit's error there.
     bool holdout = true;
     // Also score the published coefficients (colour=spectral, the atmosphere's
     // albedo) on the same samples at turbidity 1, 1.5, ..., 10.
