@@ -1,5 +1,5 @@
 // atmos CLI: `atmos fit`: fits a fitted model (`neural`: its networks;
-// `hosek-wilkie`: its coefficients, studies/hosek_wilkie_fit.h) to a reference
+// `hosek-wilkie`: its coefficients, models/hosek_wilkie_fit.h) to a reference
 // model and writes them as JSON.
 #include <chrono>
 #include <cstdio>
@@ -16,9 +16,9 @@
 #include "base/parallel.h"
 #include "cli_common.h"
 #include "io/output_path.h"
+#include "models/hosek_wilkie_fit.h"
 #include "models/neural_train.h"
 #include "render/progressive.h"
-#include "studies/hosek_wilkie_fit.h"
 
 namespace atmos::cli {
 
@@ -100,7 +100,7 @@ int CmdFitHosekWilkie(const FitOptions& o) {
 }
 
 int CmdFit(const FitOptions& o) {
-    if (o.model == "hosek-wilkie") return CmdFitHosekWilkie(o);
+    if (FitsHosekWilkieForm(o.model)) return CmdFitHosekWilkie(o);
     for (const char* flag : kHosekOnlyFlags) {
         if (o.command->count(flag) > 0)
             Fail("fit: ", flag, " applies to --model hosek-wilkie only");

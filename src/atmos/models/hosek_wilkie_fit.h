@@ -1,5 +1,9 @@
-// atmos studies: Hosek-Wilkie for any atmosphere (`atmos fit --model hosek-wilkie`,
-// issue 34 item 5; docs/models/hosek-wilkie.md "Fitted to any atmosphere").
+// atmos model `hosek-wilkie`: the form fitted to any atmosphere (`atmos fit
+// --model hosek-wilkie`, issue 34 item 5; docs/models/hosek-wilkie.md "Fitted to
+// any atmosphere"). It lives beside the model, as neural_train.h beside
+// `neural`: it needs the form's internals (hosek_wilkie.h), which the layers
+// above the models do not see. Shape of a study: a config whose member
+// initialisers are the defaults, a check, a run returning plain data, a writer.
 //
 // The nine-parameter form F(theta, gamma) of Hosek & Wilkie 2012 (eq. 8-9) and
 // its radiance scale L_M, each a quintic Bezier of six control points over
@@ -55,6 +59,10 @@ struct HosekWilkieFitConfig {
 // Checks the ranges (one atmos::Error naming the field) and the reference
 // spec (a model that gives radiance; not a transmittance model).
 void ResolveHosekWilkieFitConfig(const HosekWilkieFitConfig& config);
+
+// Whether `model` (a model spec) is this form, the one RunHosekWilkieFit fits:
+// decided by the model's type, not its name (false for a spec that does not parse).
+bool FitsHosekWilkieForm(const std::string& model);
 
 // The reference's radiance on the fit's grid (elevation-major, then zenith,
 // then azimuth).

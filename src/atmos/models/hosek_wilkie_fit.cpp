@@ -1,11 +1,11 @@
-// atmos studies: the Hosek-Wilkie fit (hosek_wilkie_fit.h).
+// atmos model `hosek-wilkie`: the fit to any atmosphere (hosek_wilkie_fit.h).
 //
 // The Levenberg-Marquardt below is atmos's own (about 60 lines): NLopt, the
 // one optimisation library atmos links (the validate study's aerosol fit),
 // has no least-squares solver that uses the residuals' Jacobian, and the
 // problems here are tiny (9 or 60 unknowns, normal equations accumulated
 // directly), so a dependency (Eigen's unsupported LM, Ceres) would buy nothing.
-#include "studies/hosek_wilkie_fit.h"
+#include "models/hosek_wilkie_fit.h"
 
 #include <algorithm>
 #include <array>
@@ -203,6 +203,15 @@ void ResolveHosekWilkieFitConfig(const HosekWilkieFitConfig& c) {
             Fail("fit: --reference ", spec.name, " gives no sky radiance (`atmos list ", spec.name,
                  "`)");
         }
+    }
+}
+
+bool FitsHosekWilkieForm(const std::string& model) {
+    try {
+        const std::unique_ptr<Model> m = CreateModel(ParseModelSpec(model));
+        return dynamic_cast<const HosekWilkieModel*>(m.get()) != nullptr;
+    } catch (const Error&) {
+        return false;
     }
 }
 
