@@ -185,13 +185,31 @@ const OptionTable<HosekWilkieOptions>& HosekWilkieModel::OptionRows() {
                     "coefficient set: the authors' RGB fit, their CIE XYZ fit (to linear sRGB), "
                     "or their spectral fit at 680/550/440 nm")
             .ShapesTables()
+            .Text("coefficients", &HosekWilkieOptions::coefficients,
+                  "coefficient file written by `atmos fit --model hosek-wilkie` (the form fitted "
+                  "to an atmosphere; turbidity, albedo and colour then do not apply)")
+            .ShapesTables()
             .Validate([](const std::string&, const HosekWilkieOptions& o,
-                         const std::set<std::string>&) { ParseAlbedo(o.albedo); });
+                         const std::set<std::string>& given) {
+                ParseAlbedo(o.albedo);
+                if (o.coefficients.empty()) return;
+                for (const char* name : {"turbidity", "albedo", "colour"}) {
+                    if (given.count(name)) {
+                        Fail("model hosek-wilkie: option ", name,
+                             " does not apply with coefficients=FILE (the file holds one "
+                             "fitted sky: no turbidity or albedo blend, RGB channels only)");
+                    }
+                }
+            });
     return table;
 }
 
 HosekWilkieModel::HosekWilkieModel(const HosekWilkieOptions& options) : options_(options) {
     albedo_ = ParseAlbedo(options.albedo);
+    if (!options.coefficients.empty()) {
+        fitted_ = std::make_shared<const HosekWilkieCoefficients>(
+            LoadHosekWilkieCoefficients(options.coefficients));
+    }
     Prepare(EarthAtmosphere());
 }
 
@@ -203,6 +221,17 @@ void HosekWilkieModel::Prepare(const AtmosphereParameters& atmosphere) {
     e.view.has_view = false;
     for (auto& row : e.mix) {
         for (double& m : row) m = 0.0;
+    }
+    if (fitted_) {
+        // The fitted control points, already in atmos's units.
+        e.sources = 3;
+        for (int c = 0; c < 3; ++c) {
+            for (int i = 0; i < 6; ++i) {
+                for (int p = 0; p < 10; ++p) e.ctrl[c][i][p] = fitted_->ctrl[c][i][p];
+            }
+            e.mix[c][c] = 1.0;
+        }
+        return;
     }
     const Vec3d& g = atmosphere.ground_albedo;
     const double mean_albedo = Clamp((g.x + g.y + g.z) / 3.0, 0.0, 1.0);
@@ -246,6 +275,10 @@ void HosekWilkieModel::Prepare(const AtmosphereParameters& atmosphere) {
 }
 
 void HosekWilkieModel::SetSpectralBatch(const SpectralAtmosphere&, const double nm[3]) {
+    if (fitted_) {
+        Fail("model hosek-wilkie: coefficients=", options_.coefficients,
+             " holds the RGB channels of its fit only: no --wavelengths");
+    }
     for (int c = 0; c < 3; ++c) {
         HosekWilkieSolarIrradiance(nm[c]);  // fails outside 320-720 nm
         nm_[c] = nm[c];

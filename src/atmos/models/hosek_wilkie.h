@@ -51,12 +51,14 @@
 // the render loop draws the sun disc itself (render/render.h).
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "models/evaluator_model.h"
 #include "models/fitted_sky.h"
+#include "models/hosek_wilkie_coefficients.h"
 #include "physics/geometry.h"
 
 namespace atmos {
@@ -157,6 +159,10 @@ struct HosekWilkieOptions {
     double turbidity = 3.0;  // atmospheric turbidity (the data's 1-10)
     std::string albedo;      // ground albedo 0-1; empty: the atmosphere's
     HosekWilkieColour colour = HosekWilkieColour::kRgb;
+    // A coefficient file of `atmos fit --model hosek-wilkie`
+    // (models/hosek_wilkie_coefficients.h); empty: the published data. With it,
+    // turbidity, albedo and colour do not apply (refused when given).
+    std::string coefficients;
 };
 
 // The published data (data/hosek-wilkie-2012/, embedded): channel count and,
@@ -207,6 +213,8 @@ class HosekWilkieModel : public SimpleEvaluatorModel<HosekWilkieModel, HosekWilk
     double albedo_ = -1.0;  // the option's value; < 0: the atmosphere's
     bool spectral_batch_ = false;
     double nm_[3] = {};
+    // Loaded from options_.coefficients (null: the published data).
+    std::shared_ptr<const HosekWilkieCoefficients> fitted_;
 };
 
 }  // namespace atmos
