@@ -142,6 +142,43 @@ TEST(RenderCache, RoundTripAndKeying) {
     EXPECT_FALSE(cache.Load(key, &loaded, &seconds));
 }
 
+// An option naming a file (neural's weights, hosek-wilkie's coefficients):
+// the file rewritten in place is a new key, so a refit into the same path is
+// never answered with the old fit's cached image.
+TEST(RenderCache, AnOptionsFileIsKeyedByItsContent) {
+    const fs::path dir = TempDir("cache-file-option");
+    const RenderCache cache(dir.string());
+    const fs::path file = dir / "coefficients.json";
+    {
+        std::ofstream out(file);
+        out << "first fit\n";
+    }
+    RenderKey key;
+    key.model = "hosek-wilkie";
+    key.options = {{"coefficients", file.string()}};
+    key.atmosphere_json = AtmosphereToJson(LoadAtmosphere("earth", {}));
+    key.view = "ground-noon";
+    key.width = 2;
+    key.height = 1;
+    const std::string first = RenderKeyText(key);
+    EXPECT_NE(first.find(" file-fnv1a="), std::string::npos) << first;
+    Image img(2, 1);
+    img.Set(1, 0, Rgb(1.0f, 2.0f, 3.0f));
+    cache.Store(key, img, 0.5);
+    Image loaded;
+    double seconds = 0.0;
+    ASSERT_TRUE(cache.Load(key, &loaded, &seconds));
+    {
+        std::ofstream out(file);
+        out << "second fit\n";
+    }
+    EXPECT_NE(RenderKeyText(key), first);
+    EXPECT_FALSE(cache.Load(key, &loaded, &seconds));
+    // A value that is not a file is keyed by its text alone.
+    key.options = {{"coefficients", (dir / "no-such-file.json").string()}};
+    EXPECT_EQ(RenderKeyText(key).find(" file-fnv1a="), std::string::npos);
+}
+
 // Issue 22: a Monte Carlo render's variance travels with its image, and a
 // model's precomputation record (seconds, table bytes) is kept per model.
 TEST(RenderCache, KeepsTheVarianceAndThePrepareRecord) {

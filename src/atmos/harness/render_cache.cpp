@@ -46,6 +46,18 @@ bool ReadNoiseMap(const std::string& path, const std::string& hash, size_t pixel
     return true;
 }
 
+// An option whose value names a regular file (`neural:weights=FILE`,
+// `hosek-wilkie:coefficients=FILE`): the file's content hash, so that a file
+// rewritten in place (a refit into the same path) is a new key, not a stale
+// image. Empty for any other value.
+std::string OptionFileHash(const std::string& value) {
+    std::error_code ec;
+    if (value.empty() || !fs::is_regular_file(value, ec)) return "";
+    std::ifstream in(value, std::ios::binary);
+    if (!in) return "";
+    return Fnv1aHex(Fnv1aStream(in));
+}
+
 }  // namespace
 
 std::string RenderKeyText(const RenderKey& key) {
@@ -53,7 +65,12 @@ std::string RenderKeyText(const RenderKey& key) {
     os << "atmos-render-cache 2\n";
     os << "build " << CodeIdentity() << "\n";
     os << "model " << key.model << "\n";
-    for (const auto& [name, value] : key.options) os << "option " << name << "=" << value << "\n";
+    for (const auto& [name, value] : key.options) {
+        os << "option " << name << "=" << value;
+        const std::string file_hash = OptionFileHash(value);
+        if (!file_hash.empty()) os << " file-fnv1a=" << file_hash;
+        os << "\n";
+    }
     if (key.monte_carlo) {
         os << "monte-carlo spp=" << key.mc.spp << " seed=" << key.mc.seed
            << " pass-spp=" << key.mc.pass_spp;

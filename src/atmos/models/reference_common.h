@@ -26,6 +26,21 @@ inline constexpr int kReferenceEstimatorVersion = 2;
 
 constexpr int kMaxReferenceShells = 64;
 
+// Russian roulette from the 4th vertex on: a path survives with probability
+// q = min(1, max_c w_c) of its throughput w (and w /= q), so a path keeps
+// going untouched while its throughput is at least 1 (conservative
+// scattering) and is thinned only as absorption and the ground's albedo lower
+// it (pbrt-v4's rule). A fixed cap below 1 (0.95 until 0.3.0) thins paths by
+// 0.95 per vertex whatever their throughput: behind a conservatively
+// scattering optical depth of tens (Venus's clouds, hundreds of vertices) the
+// few survivors then carry weights of 10^6 and the estimate is unbiased but
+// does not converge. Beyond kRouletteCapOrder vertices the cap 0.95 returns, so
+// that every path ends (a closed, lossless medium would never let go of one).
+constexpr int kRouletteCapOrder = 100000;
+ATMOS_HD inline double RouletteSurvival(int order, double max_weight) {
+    return Min(order < kRouletteCapOrder ? 1.0 : 0.95, max_weight);
+}
+
 // Shells of the piecewise-constant majorant: shell i spans radii
 // [radius[i], radius[i + 1]); radius[0] = bottom, radius[count] = top.
 struct MajorantShells {

@@ -456,7 +456,7 @@ struct ReferenceHybrid : ReferenceBaseline {
                 new_segment = true;
             }
             if (order >= 3) {
-                const double q = Min(0.95, MaxComponent(w));
+                const double q = RouletteSurvival(order, MaxComponent(w));
                 if (rng.Uniform() >= q) break;
                 w = w * (1.0 / q);
             }

@@ -315,7 +315,7 @@ struct ReferenceTracking {
             }
             // Russian roulette from the 4th vertex on (unlimited orders).
             if (order >= 3) {
-                const double q = Min(0.95, MaxComponent(w));
+                const double q = RouletteSurvival(order, MaxComponent(w));
                 if (rng.Uniform() >= q) break;
                 w = w * (1.0 / q);
             }
