@@ -39,14 +39,21 @@ std::string ReadBounded(std::FILE* file, const std::string& what, size_t max_byt
             const size_t before = text.size();
             text.append(chunk, n);
             if (max_line > 0) {
-                for (size_t i = before; i < text.size(); ++i) {
-                    if (text[i] == '\n') {
-                        line_start = i + 1;
-                        ++line_number;
-                    } else if (i - line_start >= max_line) {
+                // Line by line with memchr: a line is too long when more than
+                // max_line characters precede its newline (or the end so far).
+                size_t at = before;
+                for (;;) {
+                    const void* nl = std::memchr(text.data() + at, '\n', text.size() - at);
+                    const size_t stop =
+                        nl ? static_cast<size_t>(static_cast<const char*>(nl) - text.data())
+                           : text.size();
+                    if (stop - line_start > max_line) {
                         Fail(what, ": line ", line_number, " is longer than ", max_line,
                              " characters");
                     }
+                    if (!nl) break;
+                    line_start = at = stop + 1;
+                    ++line_number;
                 }
             }
         }

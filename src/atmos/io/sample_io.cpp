@@ -111,12 +111,16 @@ std::vector<SampleQuery> ReadQueries(const std::string& input) {
 
 namespace {
 
-// Appends `value` as printf's "%.{precision}g" would (std::to_chars with a
-// precision is specified to match it) and `sep`.
-void AppendNumber(std::string* out, size_t* used, double value, int precision, char sep) {
+// Appends `value` in its shortest form that reads back to the same number
+// (std::to_chars without a precision: Ryu, general notation as printf's %g
+// chooses it) and `sep`. A double query reads back as the same double, a
+// float answer as the same float; "%.17g" / "%.9g" (before 0.3.0) printed
+// the same values with more digits at 3x the instructions.
+template <typename T>
+void AppendNumber(std::string* out, size_t* used, T value, char sep) {
     char* first = out->data() + *used;
-    const std::to_chars_result r = std::to_chars(first, out->data() + out->size(), value,
-                                                 std::chars_format::general, precision);
+    const std::to_chars_result r =
+        std::to_chars(first, out->data() + out->size(), value, std::chars_format::general);
     *r.ptr = sep;
     *used = static_cast<size_t>(r.ptr + 1 - out->data());
 }
@@ -127,7 +131,7 @@ void AppendNumber(std::string* out, size_t* used, double value, int precision, c
 std::string FormatAnswersCsv(const std::vector<SampleQuery>& queries,
                              const std::vector<SampleAnswer>& answers) {
     static const char kHeader[] = "altitude_m,mu,mu_s,azimuth_deg,L_r,L_g,L_b,T_r,T_g,T_b\n";
-    // At most 24 characters per "%.17g" number and 16 per "%.9g" one.
+    // At most 24 characters per double and 16 per float (shortest form).
     constexpr size_t kMaxRow = 4 * 25 + 6 * 17;
     std::string out(sizeof kHeader - 1 + queries.size() * kMaxRow, '\0');
     std::memcpy(out.data(), kHeader, sizeof kHeader - 1);
@@ -135,13 +139,13 @@ std::string FormatAnswersCsv(const std::vector<SampleQuery>& queries,
     for (size_t i = 0; i < queries.size(); ++i) {
         const SampleQuery& q = queries[i];
         const SampleAnswer& a = answers[i];
-        AppendNumber(&out, &used, q.altitude_m, 17, ',');
-        AppendNumber(&out, &used, q.mu, 17, ',');
-        AppendNumber(&out, &used, q.mu_s, 17, ',');
-        AppendNumber(&out, &used, q.azimuth_deg, 17, ',');
+        AppendNumber(&out, &used, q.altitude_m, ',');
+        AppendNumber(&out, &used, q.mu, ',');
+        AppendNumber(&out, &used, q.mu_s, ',');
+        AppendNumber(&out, &used, q.azimuth_deg, ',');
         const float v[6] = {a.radiance.x,      a.radiance.y,      a.radiance.z,
                             a.transmittance.x, a.transmittance.y, a.transmittance.z};
-        for (int c = 0; c < 6; ++c) AppendNumber(&out, &used, v[c], 9, c == 5 ? '\n' : ',');
+        for (int c = 0; c < 6; ++c) AppendNumber(&out, &used, v[c], c == 5 ? '\n' : ',');
     }
     out.resize(used);
     return out;

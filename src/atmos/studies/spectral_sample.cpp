@@ -2,6 +2,7 @@
 #include "studies/spectral_sample.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 
 #include "atmos/spectral.h"
@@ -15,11 +16,17 @@ std::string SpectralSampleCsv(const std::vector<double>& nm,
     const size_t n = nm.size();
     std::string text;
     char cell[64];
-    // A number as printf's %.17g (the query's inputs) or %.9g (float outputs).
-    const auto put = [&](bool comma, bool full_precision, double v) {
+    // A query's input as its shortest text that reads back to the same double
+    // (as the RGB `sample` echoes it), a radiance as printf's %.9g.
+    const auto put = [&](bool comma, bool query, double v) {
         if (comma) text += ',';
-        const int len = full_precision ? std::snprintf(cell, sizeof cell, "%.17g", v)
-                                       : std::snprintf(cell, sizeof cell, "%.9g", v);
+        if (query) {
+            const std::to_chars_result r =
+                std::to_chars(cell, cell + sizeof cell, v, std::chars_format::general);
+            text.append(cell, static_cast<size_t>(r.ptr - cell));
+            return;
+        }
+        const int len = std::snprintf(cell, sizeof cell, "%.9g", v);
         text.append(cell, static_cast<size_t>(std::max(len, 0)));
     };
     text += "altitude_m,mu,mu_s,azimuth_deg";
