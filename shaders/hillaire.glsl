@@ -278,6 +278,9 @@ void atmos_Evaluate(vec3 camera, vec3 dir, vec3 sun, out vec3 sky, out vec3 grou
                     out vec3 transmittance, out bool hits_ground) {
     float t_start, t_end;
     if (!atmos_BeginRay(camera, dir, sky, ground, transmittance, hits_ground, t_start, t_end)) {
+        // A camera on the ground looking down sees the lit ground at its feet
+        // through no air (physics/ray.h GroundAtCamera).
+        if (hits_ground && atmos_GroundReflects()) ground = atmos_GroundReflection(camera, sun);
         return;
     }
     float r = length(camera);

@@ -4,7 +4,11 @@
 // float32 tables with shaders/NAME.glsl into a float framebuffer, the page
 // puts the pixels in the DOM (read back with --dump-dom), and each must match
 // `atmos render --load` of the same view from the same tables: mean HDR-FLIP
-// <= 0.01. Skipped, with one line, where Chromium cannot start or has no WebGL2.
+// <= 0.01; so must a free view given as the page's URL state (issue 35 item 5)
+// and `atmos render --camera --sun` of it. The page directory holds one copy
+// of each table (tables.f32), the state round-trips through the URL's hash, and
+// the benchmark mode prints a median per model. Skipped, with one line, where
+// Chromium cannot start or has no WebGL2.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -62,14 +66,49 @@ std::string DecodeBase64(const std::string& text) {
     return out;
 }
 
-// The value of attribute `name` in the tag that starts at `tag`.
+// The value of attribute `name` in the tag that starts at `tag` (&amp; as &).
 std::string Attribute(const std::string& html, size_t tag, const std::string& name) {
     const size_t end = html.find('>', tag);
     const size_t at = html.find(" " + name + "=\"", tag);
     if (at == std::string::npos || at > end) return "";
     const size_t begin = at + name.size() + 3;
-    return html.substr(begin, html.find('"', begin) - begin);
+    std::string value = html.substr(begin, html.find('"', begin) - begin);
+    for (size_t amp = value.find("&amp;"); amp != std::string::npos;
+         amp = value.find("&amp;", amp + 1)) {
+        value.erase(amp + 1, 4);
+    }
+    return value;
 }
+
+// Runs headless Chromium on `url`, the DOM into `dom`; `extra`: more flags.
+int RunChromium(const std::string& chromium, const fs::path& dir, const std::string& url,
+                const fs::path& dom, const std::string& extra = "") {
+    return System("timeout 120 " + chromium +
+                  " --headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader"
+                  " --allow-file-access-from-files"
+                  " --disable-quic --no-first-run --disable-background-networking"
+                  " --disable-component-update --disable-sync --user-data-dir=" +
+                  (dir / "profile").string() + extra + " --dump-dom '" + url + "' > " +
+                  dom.string() + " 2> " + (dir / "chromium.log").string());
+}
+
+// Every regular file under `dir` with its size.
+std::map<std::string, uintmax_t> FileSizes(const fs::path& dir) {
+    std::map<std::string, uintmax_t> sizes;
+    for (const auto& e : fs::recursive_directory_iterator(dir)) {
+        if (e.is_regular_file()) sizes[fs::relative(e.path(), dir).string()] = e.file_size();
+    }
+    return sizes;
+}
+
+// The view the test gives the page as its URL state: a free camera 1.5 km up,
+// looking 20 degrees down (the lit ground fills the lower part), and a sun of
+// its own; `atmos render --camera/--sun` of the same view.
+constexpr const char* kState =
+    "m=bruneton&m2=hillaire&split=1&pos=0.35&view=&alt=1500&az=200&el=-20&fov=70&sun_az=120&"
+    "sun_el=25&exp=1.5&disc=0";
+constexpr const char* kStateCamera =
+    " --camera altitude=1500,azimuth=200,elevation=-20,fov=70 --sun elevation=25,azimuth=120";
 
 struct BrowserImage {
     std::string model, view;
@@ -77,9 +116,78 @@ struct BrowserImage {
     atmos::Image image;
 };
 
+// The lines of the page's benchmark output (<pre id="atmos-bench">) in `html`:
+// each model's median (ms) by name; `header`: the first line; `done`: its status.
+std::map<std::string, double> BenchMedians(const std::string& html, const std::string& size,
+                                           const std::string& runs, const std::string& timer,
+                                           std::string* header, std::string* done) {
+    std::map<std::string, double> medians;
+    const size_t bench_tag = html.find("id=\"atmos-bench\"");
+    if (bench_tag == std::string::npos) return medians;
+    *done = Attribute(html, html.rfind('<', bench_tag), "data-status");
+    const size_t begin = html.find('>', bench_tag) + 1;
+    std::stringstream lines(html.substr(begin, html.find('<', begin) - begin));
+    std::string line;
+    std::getline(lines, *header);
+    std::printf("%s\n", header->c_str());
+    while (std::getline(lines, line)) {
+        std::printf("%s\n", line.c_str());
+        const size_t m = line.find(" model="), med = line.find(" median_ms=");
+        if (m == std::string::npos || med == std::string::npos) continue;
+        EXPECT_NE(line.find(" size=" + size + " runs=" + runs + " "), std::string::npos) << line;
+        EXPECT_NE(line.find(" timer=" + timer), std::string::npos) << line;
+        const std::string name = line.substr(m + 7, line.find(' ', m + 7) - m - 7);
+        medians[name] = std::atof(line.c_str() + med + 11);
+    }
+    return medians;
+}
+
+// The interactive page from the URL state kState with the benchmark mode
+// (?bench=2, a small frame, finish-bracketed: synchronous, so --dump-dom sees
+// it): the state comes back unchanged (parsed, shown, published to the hash),
+// and each of the page's `model_count` models has a positive median. Then the
+// GPU-timer path (asynchronous: --virtual-time-budget lets --dump-dom wait),
+// where the browser has EXT_disjoint_timer_query_webgl2 (SwiftShader has).
+void ExpectStateAndBench(const std::string& chromium, const fs::path& dir, const fs::path& page,
+                         size_t model_count) {
+    const fs::path dom = dir / "bench.html";
+    const std::string url =
+        "file://" + (page / "index.html").string() + "?bench=2&size=192x108&timer=finish#" + kState;
+    RunChromium(chromium, dir, url, dom);
+    std::string html = Slurp(dom);
+    const size_t status_tag = html.find("id=\"atmos-test\"");
+    ASSERT_NE(status_tag, std::string::npos) << html.substr(0, 2000);
+    const size_t open = html.rfind('<', status_tag);
+    ASSERT_EQ(Attribute(html, open, "data-status"), "viewer")
+        << Attribute(html, open, "data-error");
+    EXPECT_EQ(Attribute(html, open, "data-state"), kState);
+    EXPECT_EQ(Attribute(html, open, "data-hash"), std::string("#") + kState);
+    std::string header, done;
+    std::map<std::string, double> medians =
+        BenchMedians(html, "192x108", "2", "finish", &header, &done);
+    EXPECT_EQ(done, "done");
+    EXPECT_NE(header.find(" timer=finish"), std::string::npos) << header;
+    EXPECT_EQ(medians.size(), model_count);
+    for (const auto& [name, ms] : medians) EXPECT_GT(ms, 0.0) << name;
+
+    RunChromium(chromium, dir,
+                "file://" + (page / "index.html").string() + "?bench=1&size=96x54#" + kState, dom,
+                " --virtual-time-budget=300000");
+    html = Slurp(dom);
+    medians = BenchMedians(html, "96x54", "1", "gpu-timer", &header, &done);
+    if (header.find(" timer=gpu-timer") == std::string::npos) {
+        std::printf("no EXT_disjoint_timer_query_webgl2 here: GPU-timer path not run\n");
+        return;
+    }
+    EXPECT_EQ(done, "done");
+    EXPECT_EQ(medians.size(), model_count);
+    for (const auto& [name, ms] : medians) EXPECT_GT(ms, 0.0) << name;
+}
+
 // The comparison above for the earth atmosphere with the `--set` flags `sets`
-// (empty, or ones that give it a second Mie lobe).
-void ExpectBrowserMatchesAtmosRender(const std::string& sets) {
+// (empty, or ones that give it a second Mie lobe and a ground albedo);
+// `state_and_bench`: also the URL state's round trip and the benchmark mode.
+void ExpectBrowserMatchesAtmosRender(const std::string& sets, bool state_and_bench) {
 #if defined(__SANITIZE_ADDRESS__)
     GTEST_SKIP()
         << "not under sanitizers (it runs the CLI and a browser; the Release suite has it)";
@@ -120,18 +228,41 @@ void ExpectBrowserMatchesAtmosRender(const std::string& sets) {
         ASSERT_TRUE(fs::exists(page / shader)) << shader;
     }
 
+    // One copy of each table (issue 35 item 5): per model tables.f32 only (no
+    // EXR, float16 blob or base64 script), as large as its JSON says; every
+    // other file is text (JSON, shaders, scripts), small beside the tables.
+    uintmax_t table_bytes = 0, other_bytes = 0;
+    for (const auto& [file, bytes] : FileSizes(page)) {
+        const fs::path p(file);
+        EXPECT_NE(p.extension(), ".exr") << file;
+        EXPECT_NE(p.extension(), ".f16") << file;
+        EXPECT_NE(p.extension(), ".ktx2") << file;
+        EXPECT_EQ(p.filename().string().rfind("tables_", 0), std::string::npos) << file;
+        if (p.filename() == "tables.f32") {
+            table_bytes += bytes;
+        } else {
+            other_bytes += bytes;
+        }
+    }
+    for (const auto& [name, spec] : models) {
+        const std::string json = Slurp(page / name / (name + ".json"));
+        const size_t at = json.find("\"float32\"");
+        ASSERT_NE(at, std::string::npos) << name;
+        const size_t b = json.find("\"bytes\":", at);
+        EXPECT_EQ(std::strtoull(json.c_str() + b + 8, nullptr, 10),
+                  fs::file_size(page / name / "tables.f32"))
+            << name;
+    }
+    std::printf("viewer directory: tables.f32 %ju bytes, everything else %ju bytes\n", table_bytes,
+                other_bytes);
+    EXPECT_LT(other_bytes, 3u << 20);
+
     const int width = 320, height = 180;
     const fs::path dom = dir / "dom.html";
     const std::string url = "file://" + (page / "index.html").string() +
                             "?test=1&format=f32&size=" + std::to_string(width) + "x" +
-                            std::to_string(height);
-    const int rc =
-        System("timeout 120 " + chromium +
-               " --headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader"
-               " --disable-quic --no-first-run --disable-background-networking"
-               " --disable-component-update --disable-sync --user-data-dir=" +
-               (dir / "profile").string() + " --dump-dom '" + url + "' > " + dom.string() + " 2> " +
-               (dir / "chromium.log").string());
+                            std::to_string(height) + "#" + kState;
+    const int rc = RunChromium(chromium, dir, url, dom);
     const std::string html = Slurp(dom);
     if (rc != 0 && html.empty()) {
         GTEST_SKIP() << "chromium could not start (exit " << rc
@@ -164,7 +295,7 @@ void ExpectBrowserMatchesAtmosRender(const std::string& sets) {
         std::memcpy(b.image.data(), bytes.data(), bytes.size());
         images.push_back(std::move(b));
     }
-    ASSERT_EQ(images.size(), 48u);  // 4 models x 12 views
+    ASSERT_EQ(images.size(), 52u);  // 4 models x (12 views + the state's)
 
     // The library from the same tables.
     const fs::path renders = dir / "render";
@@ -172,6 +303,15 @@ void ExpectBrowserMatchesAtmosRender(const std::string& sets) {
         ASSERT_EQ(System(cli + " render" + sets + " --model " + spec + " --load " +
                          (page / name).string() + " --view all --size " + std::to_string(width) +
                          "x" + std::to_string(height) + " --quiet -o " + renders.string() + " > " +
+                         (dir / "render.log").string() + " 2>&1"),
+                  0)
+            << Slurp(dir / "render.log");
+    }
+    for (const auto& [name, spec] : models) {
+        ASSERT_EQ(System(cli + " render" + sets + " --model " + spec + " --load " +
+                         (page / name).string() + kStateCamera + " --size " +
+                         std::to_string(width) + "x" + std::to_string(height) + " --quiet -o " +
+                         (renders / (spec + "-state.exr")).string() + " > " +
                          (dir / "render.log").string() + " 2>&1"),
                   0)
             << Slurp(dir / "render.log");
@@ -186,17 +326,21 @@ void ExpectBrowserMatchesAtmosRender(const std::string& sets) {
                     b.view.c_str(), flip.mean, b.ms);
         EXPECT_LE(flip.mean, 0.01) << b.model << " " << b.view;
     }
+    if (state_and_bench) ExpectStateAndBench(chromium, dir, page, models.size());
     fs::remove_all(dir);
 }
 
 TEST(Viewer, WebGlRenderingOfTheBakedTablesMatchesAtmosRender) {
-    ExpectBrowserMatchesAtmosRender("");
+    ExpectBrowserMatchesAtmosRender("", true);
 }
 
-TEST(Viewer, WebGlRenderingMatchesAtmosRenderWithTwoMieLobes) {
+TEST(Viewer, WebGlRenderingMatchesAtmosRenderWithTwoMieLobesAndAGroundAlbedo) {
     // The shaders' second lobe (ATMOS_MIE_PHASE_G2, ATMOS_MIE_PHASE_WEIGHT2 in
     // the baked constants) against the library's MiePhase.
-    ExpectBrowserMatchesAtmosRender(" --set mie_phase_g2=0.95 --set mie_phase_weight2=0.3");
+    // With a ground albedo: the lit ground (the state's free view looks down
+    // at it) as `atmos render` shows it.
+    ExpectBrowserMatchesAtmosRender(
+        " --set mie_phase_g2=0.95 --set mie_phase_weight2=0.3 --set ground_albedo=0.3", false);
 }
 
 }  // namespace

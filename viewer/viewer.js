@@ -58,12 +58,6 @@ function standardViews(R, top) {
 }
 
 // ---- tables ----
-function decodeBase64(text) {
-  var bin = atob(text);
-  var bytes = new Uint8Array(bin.length);
-  for (var i = 0; i < bin.length; ++i) bytes[i] = bin.charCodeAt(i);
-  return bytes.buffer;
-}
 function encodeBase64(buffer) {
   var bytes = new Uint8Array(buffer);
   var parts = [];
@@ -73,17 +67,62 @@ function encodeBase64(buffer) {
   return btoa(parts.join(''));
 }
 
-// A texture from the bake's raw blob: "raw" -> tables -> NAME gives sizes and
-// offsets (src/atmos/io/raw_tables.h).
+// Loads MODEL/tables.f32 (the one copy of the bake's tables, issue 35) for
+// each model; done(blobs) or fail(message). Asynchronous, except in the test
+// and benchmark modes (`sync`): headless Chromium's --dump-dom writes the DOM
+// at the load event, which an asynchronous request does not hold back.
+function loadTables(names, sync, done, failOnce) {
+  var blobs = {}, left = names.length, failed = false;
+  var fail = function (msg) { if (!failed) { failed = true; failOnce(msg); } };
+  function refused(name, why) {
+    var msg = 'cannot read ' + name + '/tables.f32 (' + why + ')';
+    if (window.location.protocol === 'file:') {
+      msg += ': browsers refuse to read files from a file:// page. Serve the folder, e.g. ' +
+             '`python3 -m http.server -d DIR 8000` and open http://localhost:8000/, or start ' +
+             'Chromium with --allow-file-access-from-files';
+    }
+    return msg;
+  }
+  if (left === 0) { done(blobs); return; }
+  names.forEach(function (name) {
+    var url = name + '/tables.f32';
+    var x = new XMLHttpRequest();
+    var ok = function () { return x.status === 200 || (x.status === 0 && x.response !== null); };
+    if (sync) {
+      // A synchronous request cannot ask for an ArrayBuffer: bytes as text.
+      x.open('GET', url, false);
+      x.overrideMimeType('text/plain; charset=x-user-defined');
+      try { x.send(); } catch (e) { fail(refused(name, String(e.message || e))); return; }
+      if (!ok()) { fail(refused(name, 'status ' + x.status)); return; }
+      var text = x.responseText;
+      var bytes = new Uint8Array(text.length);
+      for (var i = 0; i < text.length; ++i) bytes[i] = text.charCodeAt(i) & 0xff;
+      blobs[name] = bytes.buffer;
+      if (--left === 0) done(blobs);
+      return;
+    }
+    x.open('GET', url, true);
+    x.responseType = 'arraybuffer';
+    x.onload = function () {
+      if (!ok()) { fail(refused(name, 'status ' + x.status)); return; }
+      blobs[name] = x.response;
+      if (--left === 0) done(blobs);
+    };
+    x.onerror = function () { fail(refused(name, 'request failed')); };
+    try { x.send(); } catch (e) { fail(refused(name, String(e.message || e))); }
+  });
+}
+
+// A texture from the bake's float32 blob: "raw" -> tables -> NAME gives sizes
+// and offsets (src/atmos/io/raw_tables.h). format 'f16': uploaded into a
+// float16 texture (WebGL2 converts float data; filterable everywhere).
 function makeTexture(gl, blob, format, entry) {
   var half = format === 'f16';
-  var n = entry.values;
-  var data = half ? new Uint16Array(blob, entry.float16_offset, n)
-                  : new Float32Array(blob, entry.float32_offset, n);
+  var data = new Float32Array(blob, entry.float32_offset, entry.values);
   var c = entry.channels;
   var internal = c === 4 ? (half ? gl.RGBA16F : gl.RGBA32F) : (half ? gl.RGB16F : gl.RGB32F);
   var fmt = c === 4 ? gl.RGBA : gl.RGB;
-  var type = half ? gl.HALF_FLOAT : gl.FLOAT;
+  var type = gl.FLOAT;
   var is3d = entry.depth > 1;
   var target = is3d ? gl.TEXTURE_3D : gl.TEXTURE_2D;
   var tex = gl.createTexture();
@@ -162,16 +201,14 @@ function compile(gl, type, source) {
 
 // One model: its program (GLSL ES header + the bake's constants + common.glsl
 // and the model's functions + MAIN_SHADER) and its textures.
-function makeModel(gl, name, format) {
+function makeModel(gl, name, format, blob) {
   var data = atmosViewerData.models[name];
-  var blobText = atmosViewerData.tables[name + '/' + format];
   // A model without tables (hosek-wilkie: constants only) has an empty blob.
-  if (!data || blobText === undefined) throw new Error('no baked data for model ' + name);
+  if (!data || blob === undefined) throw new Error('no baked data for model ' + name);
   var fragment = '#version 300 es\nprecision highp float;\nprecision highp sampler2D;\n' +
                  'precision highp sampler3D;\n' + data.constants + '\n' + data.functions +
                  '\n' + MAIN_SHADER;
   var program = linkProgram(gl, fragment);
-  var blob = decodeBase64(blobText);
   var raw = data.bake.raw.tables;
   // Texture units: the sampler names of the model's GLSL file.
   var samplers = {
@@ -379,7 +416,7 @@ function drawView(gl, model, view, width, height, opts, x0, x1, target) {
   gl.uniform1f(u('u_tan_half_fov_y'), c.tanHalfFovY);
   gl.uniform2f(u('u_size'), width, height);
   gl.uniform3fv(u('u_sun'), vNormalize(view.sun));
-  gl.uniform1f(u('u_sun_irradiance'), 6.0);
+  gl.uniform1f(u('u_sun_irradiance'), view.irradiance === undefined ? 6.0 : view.irradiance);
   gl.uniform1f(u('u_exposure'), opts.exposure);
   gl.uniform1i(u('u_raw'), opts.raw ? 1 : 0);
   gl.uniform1i(u('u_sun_disc'), opts.sunDisc ? 1 : 0);
@@ -391,7 +428,7 @@ function drawView(gl, model, view, width, height, opts, x0, x1, target) {
 }
 
 // ---- test mode: every view of every model into float images in the DOM ----
-function runTests(gl, format) {
+function runTests(gl, format, blobs) {
   var out = document.getElementById('atmos-test');
   var size = (atmosViewerParams.get('size') || '320x180').split('x');
   var width = parseInt(size[0], 10), height = parseInt(size[1], 10);
@@ -406,8 +443,15 @@ function runTests(gl, format) {
   var rgb = new Float32Array(width * height * 3);
   var html = [];
   atmosViewerModels.forEach(function (name) {
-    var model = makeModel(gl, name, format);
-    standardViews(model.bottom, model.top).forEach(function (view) {
+    var model = makeModel(gl, name, format, blobs[name]);
+    var views = standardViews(model.bottom, model.top);
+    // With a state in the hash, its view too (named "state"; a free camera
+    // is `atmos render --camera --sun`'s, irradiance 1).
+    if (window.location.hash) {
+      var v = stateView(parseState(window.location.hash), views, model.bottom);
+      views.push({name: 'state', camera: v.camera, sun: v.sun, irradiance: v.irradiance});
+    }
+    views.forEach(function (view) {
       var t0 = performance.now();
       drawView(gl, model, view, width, height, {raw: true, sunDisc: false, exposure: 1}, 0,
                width, fb);
@@ -431,6 +475,208 @@ function runTests(gl, format) {
   out.setAttribute('data-status', 'ok');
 }
 
+// ---- the view's state, in the URL's hash (a link reproduces the view) ----
+// Keys: m, m2 (left / right model), split (0|1), pos (the seam, 0..1 of the
+// width), view (a standard view, or empty for the free camera below), alt
+// (camera altitude, m), az, el (look azimuth clockwise from north, elevation,
+// deg), fov (vertical, deg), sun_az, sun_el (deg), exp (log2 exposure), disc
+// (sun disc 0|1). The free camera and sun are `atmos render --camera
+// altitude=..,azimuth=..,elevation=..,fov=.. --sun elevation=..,azimuth=..`'s
+// (src/atmos/harness/camera_spec.cpp), with its unit sun irradiance.
+var STATE_KEYS = ['m', 'm2', 'split', 'pos', 'view', 'alt', 'az', 'el', 'fov', 'sun_az', 'sun_el',
+                  'exp', 'disc'];
+function defaultState() {
+  var m = atmosViewerModels;
+  return {m: m[0], m2: m.length > 1 ? m[1] : m[0], split: 0, pos: 0.5, view: '', alt: 0, az: 90,
+          el: 10, fov: 60, sun_az: 90, sun_el: 6, exp: 2.6, disc: 1};
+}
+function clampNum(x, lo, hi, fallback) {
+  x = parseFloat(x);
+  return isFinite(x) ? Math.min(hi, Math.max(lo, x)) : fallback;
+}
+// Rounds to `digits` decimals without a trailing '.0' ('1.5', '90', '-3.25').
+function fmtNum(x, digits) { return String(parseFloat(x.toFixed(digits))); }
+function parseState(text) {
+  var p = new URLSearchParams(text.replace(/^[#?]/, ''));
+  var s = defaultState();
+  var known = function (n) { return atmosViewerModels.indexOf(n) >= 0; };
+  if (p.has('m') && known(p.get('m'))) s.m = p.get('m');
+  if (p.has('m2') && known(p.get('m2'))) s.m2 = p.get('m2');
+  if (p.has('split')) s.split = p.get('split') === '1' ? 1 : 0;
+  s.pos = clampNum(p.get('pos'), 0.05, 0.95, s.pos);
+  if (p.has('view')) s.view = p.get('view');
+  s.alt = clampNum(p.get('alt'), 0, 5e7, s.alt);
+  s.az = clampNum(p.get('az'), -360, 360, s.az);
+  s.el = clampNum(p.get('el'), -89.5, 89.5, s.el);
+  s.fov = clampNum(p.get('fov'), 5, 120, s.fov);
+  s.sun_az = clampNum(p.get('sun_az'), -360, 360, s.sun_az);
+  s.sun_el = clampNum(p.get('sun_el'), -90, 90, s.sun_el);
+  s.exp = clampNum(p.get('exp'), -4, 8, s.exp);
+  if (p.has('disc')) s.disc = p.get('disc') === '0' ? 0 : 1;
+  return s;
+}
+function formatState(s) {
+  var v = {m: s.m, m2: s.m2, split: s.split ? 1 : 0, pos: fmtNum(s.pos, 3), view: s.view,
+           alt: fmtNum(s.alt, 1), az: fmtNum(s.az, 2), el: fmtNum(s.el, 2), fov: fmtNum(s.fov, 2),
+           sun_az: fmtNum(s.sun_az, 2), sun_el: fmtNum(s.sun_el, 2), exp: fmtNum(s.exp, 2),
+           disc: s.disc ? 1 : 0};
+  return STATE_KEYS.map(function (k) {
+    return k + '=' + encodeURIComponent(String(v[k]));
+  }).join('&');
+}
+// A direction at azimuth (deg clockwise from north, +y; east +x) and elevation.
+function compassDirection(azDeg, elDeg) {
+  var a = radians(azDeg), e = radians(elDeg);
+  return [Math.sin(a) * Math.cos(e), Math.cos(a) * Math.cos(e), Math.sin(e)];
+}
+// The view a state shows: a standard view (irradiance 6), or the free camera
+// at (0, 0, R + alt) and free sun of `atmos render --camera/--sun` (irradiance 1).
+function stateView(s, views, R) {
+  for (var i = 0; i < views.length; ++i) {
+    var v = views[i];
+    // The picture of `atmos render --view` at irradiance 1 (its 6 is in the exposure).
+    if (v.name === s.view) {
+      return {name: v.name, irradiance: 1, camera: v.camera, sun: v.sun, exposure: v.exposure};
+    }
+  }
+  return {name: '', irradiance: 1,
+          camera: makeCamera([0, 0, R + s.alt], compassDirection(s.az, s.el), [0, 0, 1], s.fov),
+          sun: compassDirection(s.sun_az, s.sun_el)};
+}
+// The free camera's sliders from a standard view's camera and sun (its exact
+// position is kept only while the view stays selected), and its exposure
+// unless `keepExposure`.
+function stateFromView(s, v, R, keepExposure) {
+  var pos = v.camera.position;
+  s.alt = Math.max(Math.sqrt(vDot(pos, pos)) - R, 0);
+  var f = v.camera.forward;
+  s.az = Math.atan2(f[0], f[1]) * 180 / Math.PI;
+  s.el = Math.min(89.5, Math.max(-89.5, Math.asin(Math.max(-1, Math.min(1, f[2]))) * 180 /
+                                            Math.PI));
+  s.fov = v.camera.vfov;
+  var sun = vNormalize(v.sun);
+  s.sun_az = Math.atan2(sun[0], sun[1]) * 180 / Math.PI;
+  s.sun_el = Math.asin(sun[2]) * 180 / Math.PI;
+  // The same picture at the free view's irradiance 1: exposure x 6.
+  if (!keepExposure) s.exp = Math.log2(v.exposure * 6);
+}
+// `atmos render` of the left model's view (the page's pixels, PNG output).
+function renderCommand(s, W, H) {
+  var cmd = 'atmos render --model ' + s.m + ' ';
+  if (s.view) {
+    cmd += '--view ' + s.view;
+  } else {
+    cmd += '--camera altitude=' + fmtNum(s.alt, 1) + ',azimuth=' + fmtNum(s.az, 2) +
+           ',elevation=' + fmtNum(s.el, 2) + ',fov=' + fmtNum(s.fov, 2) + ' --sun elevation=' +
+           fmtNum(s.sun_el, 2) + ',azimuth=' + fmtNum(s.sun_az, 2);
+  }
+  var exposure = Math.pow(2, s.exp) * (s.view ? 1 / 6 : 1);
+  return cmd + (s.disc ? ' --sun-disc' : '') + ' --exposure ' + fmtNum(exposure, 4) +
+         ' --size ' + W + 'x' + H + ' -o view.png';
+}
+
+// ---- GPU timing: EXT_disjoint_timer_query_webgl2 where the browser has it ----
+function makeTimer(gl, force) {
+  var ext = force === 'finish' ? null : gl.getExtension('EXT_disjoint_timer_query_webgl2');
+  return {ext: ext, label: ext ? 'gpu-timer' : 'finish', pixel: new Uint8Array(4)};
+}
+// Times draw() on the GPU (timer query; done(ms) once the result is in, polled
+// from later tasks) or, without the extension, by performance.now() around
+// draw(), gl.finish() and a one-pixel readPixels (the CPU waits for the GPU;
+// includes the browser's and driver's overhead), done(ms) at once.
+function timeDraw(gl, timer, draw, done) {
+  if (!timer.ext) {
+    var t0 = performance.now();
+    draw();
+    gl.finish();
+    // finish() need not wait in a browser (Chromium's returns at once): a
+    // one-pixel read of the drawn framebuffer does.
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, timer.pixel);
+    done(performance.now() - t0);
+    return;
+  }
+  var q = gl.createQuery();
+  gl.beginQuery(timer.ext.TIME_ELAPSED_EXT, q);
+  draw();
+  gl.endQuery(timer.ext.TIME_ELAPSED_EXT);
+  // Wait for the draw (the query times the GPU only): the result is then
+  // ready at the next task (WebGL makes it available no sooner).
+  gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, timer.pixel);
+  var poll = function () {
+    if (!gl.getQueryParameter(q, gl.QUERY_RESULT_AVAILABLE)) { setTimeout(poll, 1); return; }
+    var disjoint = gl.getParameter(timer.ext.GPU_DISJOINT_EXT);
+    var ns = gl.getQueryParameter(q, gl.QUERY_RESULT);
+    gl.deleteQuery(q);
+    done(disjoint ? NaN : ns / 1e6);
+  };
+  setTimeout(poll, 0);
+}
+function median(xs) {
+  var v = xs.filter(function (x) { return isFinite(x); }).sort(function (a, b) { return a - b; });
+  if (v.length === 0) return NaN;
+  var h = v.length >> 1;
+  return v.length % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
+}
+
+// ---- benchmark mode (?bench=N[&size=WxH][&timer=finish]) ----
+// Per model, one frame of the state's view at WxH (default 1920x1080) into an
+// RGBA8 framebuffer as the page shows it (hillaire's sky-view and
+// aerial-perspective passes included), once to warm up (shader compiles) and
+// then N times; prints the median, also to the console, one line a model:
+//   atmos-bench model=NAME size=WxH runs=N median_ms=X min_ms=Y timer=gpu-timer|finish
+function runBench(gl, models, state, views, done) {
+  var runs = Math.max(1, Math.min(1000, parseInt(atmosViewerParams.get('bench'), 10) || 1));
+  var size = (atmosViewerParams.get('size') || '1920x1080').split('x');
+  var width = parseInt(size[0], 10), height = parseInt(size[1], 10);
+  var timer = makeTimer(gl, atmosViewerParams.get('timer'));
+  var fb = gl.createFramebuffer();
+  var rb = gl.createRenderbuffer();
+  gl.bindRenderbuffer(gl.RENDERBUFFER, rb);
+  gl.renderbufferStorage(gl.RENDERBUFFER, gl.RGBA8, width, height);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+  gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.RENDERBUFFER, rb);
+  var out = document.getElementById('atmos-bench');
+  var renderer = gl.getParameter(gl.RENDERER);
+  var info = gl.getExtension('WEBGL_debug_renderer_info');
+  if (info) renderer = gl.getParameter(info.UNMASKED_RENDERER_WEBGL);
+  var lines = ['atmos-bench renderer="' + String(renderer).replace(/"/g, "'") + '" timer=' +
+               timer.label + (timer.ext ? '' : ' (performance.now around draw, gl.finish and a ' +
+                                             'one-pixel readPixels: includes browser overhead)')];
+  out.textContent = lines.join('\n');
+  console.log(lines[0]);
+  var names = atmosViewerModels.slice();
+  var opts = {raw: false, sunDisc: !!state.disc, exposure: Math.pow(2, state.exp)};
+  function nextModel() {
+    if (names.length === 0) {
+      out.setAttribute('data-status', 'done');
+      if (done) done();
+      return;
+    }
+    var name = names.shift(), model = models[name];
+    var view = stateView(state, views, model.bottom);
+    var draw = function () { drawView(gl, model, view, width, height, opts, 0, width, fb); };
+    var times = [];
+    timeDraw(gl, timer, draw, function () {  // the warm-up frame
+      var left = runs;
+      var again = function () {
+        timeDraw(gl, timer, draw, function (ms) {
+          times.push(ms);
+          if (--left > 0) { again(); return; }
+          var line = 'atmos-bench model=' + name + ' size=' + width + 'x' + height + ' runs=' +
+                     runs + ' median_ms=' + median(times).toFixed(3) + ' min_ms=' +
+                     Math.min.apply(null, times).toFixed(3) + ' timer=' + timer.label;
+          lines.push(line);
+          console.log(line);
+          out.textContent = lines.join('\n');
+          nextModel();
+        });
+      };
+      again();
+    });
+  }
+  nextModel();
+}
+
 // ---- interactive viewer ----
 function atmosViewerMain() {
   var status = document.getElementById('atmos-test');
@@ -438,33 +684,46 @@ function atmosViewerMain() {
   var format = atmosViewerParams.get('format');
   var canvas = document.getElementById('canvas');
   var gl = canvas.getContext('webgl2', {antialias: false, preserveDrawingBuffer: true});
+  function report(e) {
+    status.setAttribute('data-status', 'error');
+    status.setAttribute('data-error', String(e.message || e));
+    errorBox.textContent = String(e.message || e);
+  }
   try {
     if (!gl) throw new Error('WebGL2 is not available in this browser');
     var linear = gl.getExtension('OES_texture_float_linear');
     if (format === 'f32' && !linear) {
       throw new Error('float32 tables need OES_texture_float_linear; open with ?format=f16');
     }
-    if (atmosViewerParams.get('test')) {
-      runTests(gl, format);
-      return;
-    }
-    runViewer(gl, canvas, format);
+    var sync = !!(atmosViewerParams.get('test') || atmosViewerParams.get('bench'));
+    loadTables(atmosViewerModels, sync, function (blobs) {
+      try {
+        if (atmosViewerParams.get('test') === '1') {
+          runTests(gl, format, blobs);
+          return;
+        }
+        runViewer(gl, canvas, format, blobs);
+      } catch (e) {
+        report(e);
+      }
+    }, report);
   } catch (e) {
-    status.setAttribute('data-status', 'error');
-    status.setAttribute('data-error', String(e.message || e));
-    errorBox.textContent = String(e.message || e);
+    report(e);
   }
 }
 
-function runViewer(gl, canvas, format) {
+function runViewer(gl, canvas, format, blobs) {
   var models = {};
-  atmosViewerModels.forEach(function (name) { models[name] = makeModel(gl, name, format); });
+  atmosViewerModels.forEach(function (name) {
+    models[name] = makeModel(gl, name, format, blobs[name]);
+  });
   var first = models[atmosViewerModels[0]];
+  var R = first.bottom;
   var views = standardViews(first.bottom, first.top);
   var el = function (id) { return document.getElementById(id); };
   var viewSelect = el('view');
   var custom = document.createElement('option');
-  custom.textContent = '(sliders)';
+  custom.textContent = '(free camera)';
   custom.value = '';
   viewSelect.appendChild(custom);
   views.forEach(function (v) {
@@ -481,45 +740,117 @@ function runViewer(gl, canvas, format) {
       el(id).appendChild(o);
     });
   });
-  var preset = null;  // a standard view's exact camera until a slider moves
-  // Altitude slider 0..1000 -> 0 m .. 50 000 km, quadratic-exponential.
-  function altitude() {
-    var s = el('alt').value / 1000;
-    return s === 0 ? 0 : Math.pow(10, 1 + s * 6.7) - 10;
+  // Hash first; the older query parameters view=NAME and split=1 still work.
+  var state = parseState(window.location.hash);
+  if (!window.location.hash) {
+    if (atmosViewerParams.get('view')) state.view = atmosViewerParams.get('view');
+    if (atmosViewerParams.get('split')) state.split = 1;
+  }
+  var known = views.some(function (v) { return v.name === state.view; });
+  if (!known) state.view = '';
+  var hashHasExposure = new URLSearchParams(window.location.hash.slice(1)).has('exp');
+  if (state.view) stateFromView(state, stateView(state, views, R), R, hashHasExposure);
+
+  // Altitude slider 0..1000 -> 0 m .. 50 000 km, exponential.
+  function altFromSlider(v) { var s = v / 1000; return s === 0 ? 0 : Math.pow(10, 1 + s * 6.7) - 10; }
+  function sliderFromAlt(a) {
+    return a <= 0 ? 0 : Math.round((Math.log10(a + 10) - 1) / 6.7 * 1000);
   }
   function fmtAlt(a) { return a < 1e4 ? a.toFixed(0) + ' m' : (a / 1e3).toFixed(0) + ' km'; }
-  function sliderView() {
-    var R = first.bottom;
-    var sun = azimuthElevation(+el('sun_az').value, +el('sun_el').value);
-    var camera = makeCamera([0, 0, R + altitude()],
-                            azimuthElevation(+el('yaw').value, +el('pitch').value), [0, 0, 1],
-                            +el('fov').value);
-    return {name: '', camera: camera, sun: sun};
+  var sliders = {sun_el: 'sun_el', sun_az: 'sun_az', az: 'yaw', el: 'pitch', fov: 'fov',
+                 exp: 'exposure', pos: 'split_pos'};
+  function showState() {
+    viewSelect.value = state.view;
+    el('model').value = state.m;
+    el('model2').value = state.m2;
+    el('split').checked = !!state.split;
+    el('sun_disc').checked = !!state.disc;
+    Object.keys(sliders).forEach(function (k) { el(sliders[k]).value = state[k]; });
+    el('alt').value = sliderFromAlt(state.alt);
+    el('sun_el_v').textContent = fmtNum(state.sun_el, 1) + '\u00b0';
+    el('sun_az_v').textContent = fmtNum(state.sun_az, 1) + '\u00b0';
+    el('alt_v').textContent = fmtAlt(state.alt);
+    el('yaw_v').textContent = fmtNum(state.az, 1) + '\u00b0';
+    el('pitch_v').textContent = fmtNum(state.el, 1) + '\u00b0';
+    el('fov_v').textContent = fmtNum(state.fov, 1) + '\u00b0';
+    el('exposure_v').textContent = 'x' + Math.pow(2, state.exp).toFixed(2);
+    el('split_pos_v').textContent = fmtNum(state.pos, 2);
+    // The seam and the labels of the split view.
+    el('seam').hidden = !state.split;
+    el('label2').hidden = !state.split;
+    el('seam').style.left = (state.pos * 100) + '%';
+    el('label1').textContent = state.m;
+    el('label2').textContent = state.m2;
+    el('label2').style.left = 'calc(' + (state.pos * 100) + '% + 8px)';
   }
-  function setSlidersFrom(v) {
-    var pos = v.camera.position;
-    var r = Math.sqrt(vDot(pos, pos));
-    var a = Math.max(r - first.bottom, 0);
-    el('alt').value = a <= 0 ? 0 : Math.round((Math.log10(a + 10) - 1) / 6.7 * 1000);
-    var f = v.camera.forward;
-    el('yaw').value = Math.atan2(f[1], f[0]) * 180 / Math.PI;
-    el('pitch').value = Math.asin(Math.max(-1, Math.min(1, f[2]))) * 180 / Math.PI;
-    el('fov').value = v.camera.vfov;
-    el('sun_el').value = Math.asin(v.sun[2]) * 180 / Math.PI;
-    el('sun_az').value = Math.atan2(v.sun[1], v.sun[0]) * 180 / Math.PI;
-    el('exposure').value = Math.log2(v.exposure);
+  function publish() {
+    var text = formatState(state);
+    // The whole state in the URL (replaceState: no history entry per slider step).
+    if (window.location.hash !== '#' + text) {
+      window.history.replaceState(null, '', window.location.pathname + window.location.search +
+                                                '#' + text);
+    }
+    el('atmos-test').setAttribute('data-state', text);
+    el('atmos-test').setAttribute('data-hash', window.location.hash);
   }
   viewSelect.addEventListener('change', function () {
-    preset = null;
-    views.forEach(function (v) { if (v.name === viewSelect.value) preset = v; });
-    if (preset) setSlidersFrom(preset);
+    state.view = viewSelect.value;
+    if (state.view) stateFromView(state, stateView(state, views, R), R);
+    changed();
   });
-  ['sun_el', 'sun_az', 'alt', 'yaw', 'pitch', 'fov'].forEach(function (id) {
-    el(id).addEventListener('input', function () { preset = null; viewSelect.value = ''; });
+  Object.keys(sliders).forEach(function (k) {
+    el(sliders[k]).addEventListener('input', function () {
+      state[k] = +el(sliders[k]).value;
+      if (k !== 'exp' && k !== 'pos') state.view = '';  // the camera or sun moved
+      changed();
+    });
   });
-  var frameTimes = [];
-  var last = performance.now();
-  function frame() {
+  el('alt').addEventListener('input', function () {
+    state.alt = altFromSlider(+el('alt').value);
+    state.view = '';
+    changed();
+  });
+  el('model').addEventListener('change', function () { state.m = el('model').value; changed(); });
+  el('model2').addEventListener('change', function () { state.m2 = el('model2').value; changed(); });
+  el('split').addEventListener('change', function () { state.split = el('split').checked ? 1 : 0; changed(); });
+  el('sun_disc').addEventListener('change', function () { state.disc = el('sun_disc').checked ? 1 : 0; changed(); });
+  window.addEventListener('hashchange', function () {
+    if (window.location.hash === '#' + formatState(state)) return;
+    state = parseState(window.location.hash);
+    if (!views.some(function (v) { return v.name === state.view; })) state.view = '';
+    var keep = new URLSearchParams(window.location.hash.slice(1)).has('exp');
+    if (state.view) stateFromView(state, stateView(state, views, R), R, keep);
+    changed();
+  });
+  // Mouse look: dragging turns the camera (the scene follows the pointer);
+  // the sun stays where it is.
+  var drag = null;
+  canvas.addEventListener('pointerdown', function (e) {
+    drag = {x: e.clientX, y: e.clientY};
+    canvas.setPointerCapture(e.pointerId);
+  });
+  canvas.addEventListener('pointerup', function () { drag = null; });
+  canvas.addEventListener('pointermove', function (e) {
+    if (!drag) return;
+    var degPerPixel = state.fov / Math.max(1, canvas.clientHeight);
+    state.az = ((state.az - (e.clientX - drag.x) * degPerPixel + 540) % 360) - 180;
+    state.el = Math.min(89.5, Math.max(-89.5, state.el + (e.clientY - drag.y) * degPerPixel));
+    drag = {x: e.clientX, y: e.clientY};
+    state.view = '';
+    changed();
+  });
+  var timer = makeTimer(gl, atmosViewerParams.get('timer'));
+  var pending = false, lastMs = NaN;
+  function changed() {
+    showState();
+    publish();
+    if (!pending) {
+      pending = true;
+      window.requestAnimationFrame(function () { pending = false; draw(); });
+    }
+  }
+  // Draws on demand (a state change), not in a loop.
+  function draw() {
     var w = canvas.clientWidth || 960;
     var h = Math.round(w * 9 / 16);
     var dpr = window.devicePixelRatio || 1;
@@ -527,45 +858,30 @@ function runViewer(gl, canvas, format) {
       canvas.width = Math.round(w * dpr);
       canvas.height = Math.round(h * dpr);
     }
-    var view = preset || sliderView();
-    var opts = {raw: false, sunDisc: el('sun_disc').checked,
-                exposure: Math.pow(2, +el('exposure').value)};
     var W = canvas.width, H = canvas.height;
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    var t0 = performance.now();
-    var a = models[el('model').value], b = models[el('model2').value];
-    if (el('split').checked) {
-      drawView(gl, a, view, W, H, opts, 0, W >> 1, null);
-      drawView(gl, b, view, W, H, opts, W >> 1, W, null);
-    } else {
-      drawView(gl, a, view, W, H, opts, 0, W, null);
-    }
-    gl.finish();
-    var draw = performance.now() - t0;
-    var now = performance.now();
-    frameTimes.push(now - last);
-    last = now;
-    if (frameTimes.length > 30) frameTimes.shift();
-    var avg = frameTimes.reduce(function (s, x) { return s + x; }, 0) / frameTimes.length;
-    el('stats').textContent = 'frame ' + avg.toFixed(1) + ' ms, draw ' + draw.toFixed(1) +
-                              ' ms, ' + W + 'x' + H + ', tables ' + format;
-    el('sun_el_v').textContent = (+el('sun_el').value).toFixed(1) + '\u00b0';
-    el('sun_az_v').textContent = (+el('sun_az').value).toFixed(1) + '\u00b0';
-    el('alt_v').textContent = fmtAlt(preset ? Math.sqrt(vDot(view.camera.position,
-                                                             view.camera.position)) -
-                                                  first.bottom : altitude());
-    el('yaw_v').textContent = (+el('yaw').value).toFixed(1) + '\u00b0';
-    el('pitch_v').textContent = (+el('pitch').value).toFixed(1) + '\u00b0';
-    el('fov_v').textContent = (+el('fov').value).toFixed(1) + '\u00b0';
-    el('exposure_v').textContent = 'x' + opts.exposure.toFixed(2);
-    window.requestAnimationFrame(frame);
+    var view = stateView(state, views, R);
+    var opts = {raw: false, sunDisc: !!state.disc, exposure: Math.pow(2, state.exp)};
+    var a = models[state.m], b = models[state.m2];
+    var xs = Math.round(state.pos * W);
+    timeDraw(gl, timer, function () {
+      if (state.split) {
+        drawView(gl, a, view, W, H, opts, 0, xs, null);
+        drawView(gl, b, view, W, H, opts, xs, W, null);
+      } else {
+        drawView(gl, a, view, W, H, opts, 0, W, null);
+      }
+    }, function (ms) {
+      lastMs = ms;
+      el('stats').textContent = 'draw ' + (isFinite(lastMs) ? lastMs.toFixed(2) + ' ms' : '?') +
+                                ' (' + (timer.ext ? 'GPU timer query' : 'finish/readPixels-bracketed, ' +
+                                        'not a GPU timer') + '), ' + W + 'x' + H + ', tables ' +
+                                format;
+    });
+    el('command').textContent = renderCommand(state, W, H);
   }
-  if (atmosViewerParams.get('view')) {
-    viewSelect.value = atmosViewerParams.get('view');
-    viewSelect.dispatchEvent(new Event('change'));
-  }
-  if (atmosViewerParams.get('split')) el('split').checked = true;
-  if (atmosViewerModels.length > 1) el('model2').value = atmosViewerModels[1];
-  document.getElementById('atmos-test').setAttribute('data-status', 'viewer');
-  window.requestAnimationFrame(frame);
+  showState();
+  publish();
+  draw();
+  el('atmos-test').setAttribute('data-status', 'viewer');
+  if (atmosViewerParams.get('bench')) runBench(gl, models, state, views);
 }

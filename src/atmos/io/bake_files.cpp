@@ -33,12 +33,45 @@ std::vector<std::string> ShaderModels() {
     return names;
 }
 
-// The page's view of one baked model: MODEL/model.js (its JSON, constants and
-// functions: common.glsl then the model's shader)
-// and MODEL/tables_f32.js, MODEL/tables_f16.js (the raw blobs in base64):
-// scripts, so that the page works from file:// where fetch() is refused.
+namespace {
+// Every string of `j` naming an EXR table names the blob instead.
+void PointTablesAtBlob(nlohmann::ordered_json* j) {
+    if (j->is_string()) {
+        const std::string v = j->get<std::string>();
+        if (v.size() > 4 && v.compare(v.size() - 4, 4, ".exr") == 0) *j = "tables.f32";
+    } else if (j->is_structured()) {
+        for (auto& child : *j) PointTablesAtBlob(&child);
+    }
+}
+}  // namespace
+
+// One copy of each table (issue 35 item 5): the bake's EXR files and
+// tables.f16 go (the page uploads the float32 blob as float16 textures when
+// asked, and --load reads tables.f32 when the EXRs are absent: io/table_io.h);
+// the JSON says so. Then the page's view of the model: MODEL/model.js (its
+// JSON, constants and functions: common.glsl then the model's shader); the
+// page loads MODEL/tables.f32 itself (XMLHttpRequest).
 void WriteViewerData(const fs::path& dir, const std::string& name) {
-    const std::string json = ReadWholeFile(dir / (name + ".json"));
+    const fs::path json_path = dir / (name + ".json");
+    nlohmann::ordered_json j = nlohmann::ordered_json::parse(ReadWholeFile(json_path));
+    if (j.contains("raw") && j["raw"].is_object()) {
+        j["raw"].erase("float16");
+        if (j["raw"].contains("tables")) {
+            for (auto& t : j["raw"]["tables"]) t.erase("float16_offset");
+        }
+    }
+    PointTablesAtBlob(&j);
+    j["viewer"] =
+        "written by atmos viewer: the tables are in tables.f32 only (the EXR files and "
+        "tables.f16 of a bake are left out; \"file\" names the blob)";
+    WriteFileAtomically(json_path.string(), j.dump(2) + "\n");
+    std::error_code ec;
+    fs::remove(dir / "tables.f16", ec);
+    std::vector<fs::path> exrs;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+        if (e.path().extension() == ".exr") exrs.push_back(e.path());
+    }
+    for (const fs::path& p : exrs) fs::remove(p, ec);
     const std::string functions =
         ReadWholeFile(dir / kCommonShader) + ReadWholeFile(dir / ShaderAsset(name));
     std::string file = name;
@@ -47,15 +80,9 @@ void WriteViewerData(const fs::path& dir, const std::string& name) {
     }
     const std::string constants = ReadWholeFile(dir / "shaders" / (file + "_constants.glsl"));
     WriteFileAtomically((dir / "model.js").string(),
-                        "atmosViewerData.models[" + JsStringLiteral(name) + "] = {bake: " + json +
-                            ", constants: " + JsStringLiteral(constants) +
+                        "atmosViewerData.models[" + JsStringLiteral(name) + "] = {bake: " +
+                            j.dump() + ", constants: " + JsStringLiteral(constants) +
                             ", functions: " + JsStringLiteral(functions) + "};\n");
-    for (const char* format : {"f32", "f16"}) {
-        const std::string blob = ReadWholeFile(dir / (std::string("tables.") + format));
-        WriteFileAtomically((dir / (std::string("tables_") + format + ".js")).string(),
-                            "atmosViewerData.tables[" + JsStringLiteral(name + "/" + format) +
-                                "] = \"" + Base64Encode(blob) + "\";\n");
-    }
 }
 
 // The model spec of the bake in `dir` (--load without --model): the JSON a

@@ -18,8 +18,9 @@ std::string ShaderAsset(const std::string& model);
 // The viewer's default list: every model with a shader, in registry order.
 std::vector<std::string> ShaderModels();
 
-// The page's view of one baked model in `dir`: model.js (its JSON, constants
-// and functions) and tables_f32.js, tables_f16.js (the raw blobs in base64).
+// Thins the bake in `dir` to one copy of each table (tables.f32; its EXR
+// files and tables.f16 are removed and its JSON says so) and writes the page's
+// view of it: model.js (its JSON, constants and functions).
 void WriteViewerData(const std::filesystem::path& dir, const std::string& name);
 
 // The model spec of the bake in `dir` (--load without --model): the JSON a

@@ -6,16 +6,68 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 
+#include <cstring>
 #include <exception>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "atmos/error.h"
+#include "io/text_files.h"
 
 namespace atmos {
 
 namespace {
 const char* const kChannelNames[4] = {"R", "G", "B", "A"};
+
+namespace fs = std::filesystem;
+
+// The table STEM of the bake in `dir` from its tables.f32 (a viewer's bake
+// keeps that blob only, docs/engine.md): the bake's JSON ("raw" -> "tables"
+// -> STEM) gives its sizes and offset; the blob's layout (channel fastest, then
+// x, y, layer) is Table's.
+Table ReadRawFloat32Table(const fs::path& dir, const std::string& stem, int depth, int channels) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+        if (e.path().extension() != ".json") continue;
+        nlohmann::json j;
+        try {
+            j = nlohmann::json::parse(ReadWholeFile(e.path()));
+        } catch (const std::exception&) {
+            continue;
+        }
+        if (!j.is_object() || !j.contains("raw") || !j["raw"].is_object() ||
+            !j["raw"].contains("tables") || !j["raw"]["tables"].contains(stem)) {
+            continue;
+        }
+        const fs::path blob_path = dir / "tables.f32";
+        try {
+            const nlohmann::json& t = j["raw"]["tables"][stem];
+            const int w = t.at("width").get<int>(), h = t.at("height").get<int>();
+            const int d = t.at("depth").get<int>(), c = t.at("channels").get<int>();
+            const size_t offset = t.at("float32_offset").get<size_t>();
+            if (d != depth || c != channels || w < 1 || h < 1) {
+                Fail("table '", stem, "' in '", blob_path.string(), "' is ", w, "x", h, "x", d,
+                     " with ", c, " channels, not ", depth, " layers of ", channels, " channels");
+            }
+            const std::string blob = ReadWholeFile(blob_path);
+            Table table(w, h, d, c);
+            const size_t bytes = table.size() * sizeof(float);
+            if (offset > blob.size() || blob.size() - offset < bytes) {
+                Fail("'", blob_path.string(), "' is too short for table '", stem, "'");
+            }
+            std::memcpy(table.data(), blob.data() + offset, bytes);  // little-endian hosts
+            return table;
+        } catch (const nlohmann::json::exception& ex) {
+            Fail("'", e.path().string(), "': raw table '", stem, "': ", ex.what());
+        }
+    }
+    Fail("cannot read table '", (dir / (stem + ".exr")).string(),
+         "': no such file, and no bake JSON in that directory describes a raw table '", stem,
+         "' in tables.f32");
 }
+}  // namespace
 
 void WriteTableExr(const Table& table, const std::string& path) {
     const int w = table.width() * table.depth();
@@ -54,6 +106,11 @@ void WriteTableExr(const Table& table, const std::string& path) {
 }
 
 Table ReadTableExr(const std::string& path, int depth, int channels) {
+    const fs::path p(path);
+    std::error_code ec;
+    if (!fs::exists(p, ec) && fs::exists(p.parent_path() / "tables.f32", ec)) {
+        return ReadRawFloat32Table(p.parent_path(), p.stem().string(), depth, channels);
+    }
     try {
         Imf::InputFile file(path.c_str());
         const Imath::Box2i dw = file.header().dataWindow();

@@ -14,6 +14,9 @@ namespace atmos {
 void WriteTableExr(const Table& table, const std::string& path);
 // Reads a table written by WriteTableExr; `depth` and `channels` come from the
 // caller (the bake's JSON). Throws atmos::Error when the sizes disagree.
+// When `path` (DIR/STEM.exr) does not exist, the table STEM is read from
+// DIR/tables.f32 as the bake's JSON describes it under "raw" (a viewer's bake
+// keeps only that blob: docs/engine.md, "The viewer").
 Table ReadTableExr(const std::string& path, int depth, int channels);
 
 }  // namespace atmos
