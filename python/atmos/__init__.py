@@ -173,10 +173,12 @@ class Atmosphere:
         return isinstance(other, Atmosphere) and self._fields == other._fields
 
     def __repr__(self):
+        phase = self.mie_phase
+        kind = phase["kind"] if isinstance(phase, dict) else phase
+        last = (f"mie_phase_g={self._fields['mie_phase_g']}" if "mie_phase_g" in self._fields
+                else f"mie_phase={kind}")
         return (f"Atmosphere(bottom_radius={self._fields['bottom_radius']}, "
-                f"top_radius={self._fields['top_radius']}, "
-                + (f"mie_phase_g={self._fields['mie_phase_g']})" if "mie_phase_g" in self._fields
-                   else f"mie_phase={self.mie_phase['kind'] if isinstance(self.mie_phase, dict) else self.mie_phase})"))
+                f"top_radius={self._fields['top_radius']}, {last})")
 
 
 def _check_finite(field, v):
