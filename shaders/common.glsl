@@ -35,16 +35,49 @@ float atmos_CornetteShanksPhase(float g, float nu) {
     float denom = 1.0 + g * g - 2.0 * g * nu;
     return k * (1.0 + nu * nu) / (denom * sqrt(denom));
 }
+// HenyeyGreensteinPhase (phase.h).
+float atmos_HenyeyGreensteinPhase(float g, float nu) {
+    float denom = 1.0 + g * g - 2.0 * g * nu;
+    return (1.0 - g * g) / (4.0 * ATMOS_PI * denom * sqrt(denom));
+}
 // MiePhase (phase.h): CornetteShanksPhase with g = ATMOS_MIE_PHASE_G, or, when
 // the constants define ATMOS_MIE_PHASE_WEIGHT2 (an atmosphere with a second
-// lobe), (1 - w) CS(ATMOS_MIE_PHASE_G) + w CS(ATMOS_MIE_PHASE_G2).
+// lobe), (1 - w) CS(ATMOS_MIE_PHASE_G) + w CS(ATMOS_MIE_PHASE_G2). When they
+// define ATMOS_MIE_PHASE_KIND (atmosphere.h MiePhaseKind): 1 the same lobes of
+// Henyey-Greenstein, 2 isotropic, 3 tabulated (TabulatedPhase: the constants'
+// atmos_MiePhaseTableMu and atmos_MiePhaseTableValue, linear in nu between nodes).
 float atmos_MiePhase(float nu) {
+#ifdef ATMOS_MIE_PHASE_KIND
+#if ATMOS_MIE_PHASE_KIND == 1
+#ifdef ATMOS_MIE_PHASE_WEIGHT2
+    float w = ATMOS_MIE_PHASE_WEIGHT2;
+    return (1.0 - w) * atmos_HenyeyGreensteinPhase(ATMOS_MIE_PHASE_G, nu) +
+           w * atmos_HenyeyGreensteinPhase(ATMOS_MIE_PHASE_G2, nu);
+#else
+    return atmos_HenyeyGreensteinPhase(ATMOS_MIE_PHASE_G, nu);
+#endif
+#elif ATMOS_MIE_PHASE_KIND == 2
+    return 1.0 / (4.0 * ATMOS_PI);
+#else
+    float x = clamp(nu, -1.0, 1.0);
+    for (int i = 0; i < ATMOS_MIE_PHASE_TABLE_COUNT - 1; ++i) {
+        float a = atmos_MiePhaseTableMu[i + 1];
+        if (x >= a) {
+            float b = atmos_MiePhaseTableMu[i];
+            float f = (b - x) / (b - a);
+            return mix(atmos_MiePhaseTableValue[i], atmos_MiePhaseTableValue[i + 1], f);
+        }
+    }
+    return atmos_MiePhaseTableValue[ATMOS_MIE_PHASE_TABLE_COUNT - 1];
+#endif
+#else
 #ifdef ATMOS_MIE_PHASE_WEIGHT2
     float w = ATMOS_MIE_PHASE_WEIGHT2;
     return (1.0 - w) * atmos_CornetteShanksPhase(ATMOS_MIE_PHASE_G, nu) +
            w * atmos_CornetteShanksPhase(ATMOS_MIE_PHASE_G2, nu);
 #else
     return atmos_CornetteShanksPhase(ATMOS_MIE_PHASE_G, nu);
+#endif
 #endif
 }
 // DistanceToTopAtmosphereBoundary (geometry.h; Bruneton's 2017 implementation notes "Distance to the top

@@ -34,6 +34,36 @@ struct DensityProfile {
     DensityProfileLayer layers[2];
 };
 
+// The kind of the aerosol (Mie) phase function (physics/phase.h MiePhase; docs/atmosphere.md
+// "Mie phase functions"). The numbers are fixed: they appear in baked constants.
+enum class MiePhaseKind : int {
+    kCornetteShanks = 0,    // one or two Cornette-Shanks lobes (mie_phase_g, _g2, _weight2)
+    kHenyeyGreenstein = 1,  // one or two Henyey-Greenstein lobes (the same three fields)
+    kIsotropic = 2,         // 1 / (4 pi)
+    kTabulated = 3,         // MiePhaseTable: values at scattering angles
+};
+
+// The most nodes a tabulated phase function may have.
+constexpr int kMaxMiePhaseNodes = 256;
+
+// A tabulated phase function, trivially copyable (per-pixel code reads it). The
+// nodes are scattering angles, increasing from 0 to 180 deg; between two nodes the
+// phase is linear in nu = cos(angle), so its integral over the sphere, its mean
+// cosine and its CDF are exact sums, and the CDF inverts in closed form (one
+// quadratic per sample: physics/sampling.h). `angle_deg` and `value` are kept as
+// given (any positive unit: AERONET's 4 pi-normalised values, per steradian, ...),
+// so that the JSON round trip is exact; `scale` makes it a phase function in 1/sr.
+// FinishMiePhaseTable fills mu, cdf, scale and mean_cosine.
+struct MiePhaseTable {
+    int count = 0;                             // nodes, 2..kMaxMiePhaseNodes
+    double scale = 0.0;                        // 1 / (integral of `value` over the sphere)
+    double mean_cosine = 0.0;                  // <nu>, the table's asymmetry parameter g
+    double angle_deg[kMaxMiePhaseNodes] = {};  // 0 = angle_deg[0] < ... < angle_deg[count-1] = 180
+    double value[kMaxMiePhaseNodes] = {};      // > 0 and finite, as given
+    double mu[kMaxMiePhaseNodes] = {};         // cos(angle_deg): 1 = mu[0] > ... = -1
+    double cdf[kMaxMiePhaseNodes] = {};        // P(angle <= angle_deg[i]); 0 .. 1
+};
+
 struct AtmosphereParameters {
     double bottom_radius = 6360e3;  // m: the planet's surface
     double top_radius = 6460e3;     // m: where the atmosphere is taken to end
@@ -48,7 +78,13 @@ struct AtmosphereParameters {
     // (physics/phase.h MiePhase); w = 0 (the default) is the single lobe.
     double mie_phase_g2 = 0.0;       // Cornette-Shanks asymmetry of the second lobe
     double mie_phase_weight2 = 0.0;  // the second lobe's weight w, [0, 1]
-    Vec3d absorption_extinction;     // 1/m at density 1 (ozone: absorption only)
+    // The phase function's kind; Cornette-Shanks (the default) reads the three
+    // fields above, Henyey-Greenstein the same three, isotropic none, tabulated
+    // mie_phase_table (mie_phase_g then holds the table's mean cosine, for models
+    // that take an asymmetry parameter).
+    MiePhaseKind mie_phase_kind = MiePhaseKind::kCornetteShanks;
+    MiePhaseTable mie_phase_table;
+    Vec3d absorption_extinction;  // 1/m at density 1 (ozone: absorption only)
     DensityProfile absorption_density;
     Vec3d ground_albedo;                    // Lambertian, [0, 1]
     double sun_angular_radius = 0.004675;   // rad
@@ -74,6 +110,14 @@ void ValidateAtmosphere(const AtmosphereParameters& atmosphere);
 // planet: 16 steps over 10^9 m would miss an 8 km scale height). For the
 // presets it is top_radius.
 double EffectiveTopRadius(const AtmosphereParameters& atmosphere, double column_depth = 1e-9);
+
+// Fills a MiePhaseTable's derived members (mu, cdf, scale, mean_cosine) from its
+// count, angle_deg and value, after checking them; throws atmos::Error naming
+// `field` (e.g. "mie_phase.values[3]") and the rule on a bad table.
+void FinishMiePhaseTable(MiePhaseTable* table, const std::string& field = "mie_phase");
+
+// "cornette-shanks", "henyey-greenstein", "isotropic", "tabulated".
+const char* MiePhaseKindName(MiePhaseKind kind);
 
 // Names of the presets shipped in data/atmospheres (without ".json").
 std::vector<std::string> AtmospherePresetNames();

@@ -88,8 +88,10 @@ def thread_count():
 
 
 # Fields the JSON text leaves out at their default (the second Mie lobe,
-# written only when it has a weight): read as attributes, settable by replace().
-_OPTIONAL_FIELDS = {"mie_phase_g2": 0.0, "mie_phase_weight2": 0.0}
+# written only when it has a weight; the phase function's kind, written only
+# when it is not Cornette-Shanks): read as attributes, settable by replace().
+_OPTIONAL_FIELDS = {"mie_phase_g2": 0.0, "mie_phase_weight2": 0.0,
+                    "mie_phase": "cornette-shanks"}
 
 
 class Atmosphere:
@@ -171,9 +173,12 @@ class Atmosphere:
         return isinstance(other, Atmosphere) and self._fields == other._fields
 
     def __repr__(self):
+        phase = self.mie_phase
+        kind = phase["kind"] if isinstance(phase, dict) else phase
+        last = (f"mie_phase_g={self._fields['mie_phase_g']}" if "mie_phase_g" in self._fields
+                else f"mie_phase={kind}")
         return (f"Atmosphere(bottom_radius={self._fields['bottom_radius']}, "
-                f"top_radius={self._fields['top_radius']}, "
-                f"mie_phase_g={self._fields['mie_phase_g']})")
+                f"top_radius={self._fields['top_radius']}, {last})")
 
 
 def _check_finite(field, v):

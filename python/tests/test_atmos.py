@@ -99,6 +99,17 @@ def test_atmosphere_load_fields_and_validation(tmp):
     with pytest.raises(ValueError, match="mie_phase_weight2"):
         earth.replace(mie_phase_weight2=1.5)
 
+    # Other phase kinds (issue 32 item 4): a kind name or a table, read back as given.
+    assert earth.mie_phase == "cornette-shanks"
+    iso = earth.replace(mie_phase="isotropic")
+    assert iso.mie_phase == "isotropic" and "mie_phase_g" not in iso.to_dict()
+    table = {"kind": "tabulated", "angles_deg": [0, 90, 180], "values": [4.0, 1.0, 2.0]}
+    tab = earth.replace(mie_phase=table)
+    assert tab.mie_phase == table and "mie_phase=tabulated" in repr(tab)
+    assert atmos.Atmosphere.load(tab.to_dict()) == tab
+    with pytest.raises(ValueError, match="mie_phase.values"):
+        earth.replace(mie_phase={"kind": "tabulated", "angles_deg": [0, 180], "values": [1, -1]})
+
 
 # ---- sample: bit for bit with `atmos sample` -------------------------------------------------
 

@@ -27,7 +27,9 @@
 #include "atmos/atmosphere.h"
 #include "atmos/embedded_presets.h"
 #include "atmos/error.h"
+#include "atmos/number.h"
 #include "atmos/spectral.h"
+#include "io/bounded_read.h"
 
 namespace atmos {
 
@@ -36,7 +38,7 @@ namespace {
 // Keeps the keys in file order, so a written file reads like the presets.
 using Json = nlohmann::ordered_json;
 
-enum class FieldKind { kScalar, kRgb, kDensity };
+enum class FieldKind { kScalar, kRgb, kDensity, kPhase };
 
 struct FieldSpec {
     const char* name;
@@ -45,14 +47,23 @@ struct FieldSpec {
 
 // The fields in the order of AtmosphereParameters (and of the files we write).
 constexpr FieldSpec kFields[] = {
-    {"bottom_radius", FieldKind::kScalar},      {"top_radius", FieldKind::kScalar},
-    {"rayleigh_scattering", FieldKind::kRgb},   {"rayleigh_density", FieldKind::kDensity},
-    {"mie_scattering", FieldKind::kRgb},        {"mie_extinction", FieldKind::kRgb},
-    {"mie_density", FieldKind::kDensity},       {"mie_phase_g", FieldKind::kScalar},
-    {"mie_phase_g2", FieldKind::kScalar},       {"mie_phase_weight2", FieldKind::kScalar},
-    {"absorption_extinction", FieldKind::kRgb}, {"absorption_density", FieldKind::kDensity},
-    {"ground_albedo", FieldKind::kRgb},         {"sun_angular_radius", FieldKind::kScalar},
-    {"solar_irradiance", FieldKind::kRgb},      {"mu_s_min", FieldKind::kScalar},
+    {"bottom_radius", FieldKind::kScalar},
+    {"top_radius", FieldKind::kScalar},
+    {"rayleigh_scattering", FieldKind::kRgb},
+    {"rayleigh_density", FieldKind::kDensity},
+    {"mie_scattering", FieldKind::kRgb},
+    {"mie_extinction", FieldKind::kRgb},
+    {"mie_density", FieldKind::kDensity},
+    {"mie_phase", FieldKind::kPhase},
+    {"mie_phase_g", FieldKind::kScalar},
+    {"mie_phase_g2", FieldKind::kScalar},
+    {"mie_phase_weight2", FieldKind::kScalar},
+    {"absorption_extinction", FieldKind::kRgb},
+    {"absorption_density", FieldKind::kDensity},
+    {"ground_albedo", FieldKind::kRgb},
+    {"sun_angular_radius", FieldKind::kScalar},
+    {"solar_irradiance", FieldKind::kRgb},
+    {"mu_s_min", FieldKind::kScalar},
 };
 
 constexpr const char* kLayerKeys[] = {"width", "exp_term", "exp_scale", "linear_term",
@@ -65,10 +76,12 @@ const char kDensityForms[] =
 // Bruneton's 2017 implementation notes' demo: max_sun_zenith_angle = 102 degrees.
 double DefaultMuSMin() { return std::cos(102.0 / 180.0 * kPi); }
 
-// The fields a file may leave out: mu_s_min (DefaultMuSMin) and the second
-// Mie lobe (weight 0: one lobe).
+// The fields a file may leave out: mu_s_min (DefaultMuSMin), the phase
+// function's kind (Cornette-Shanks), the second Mie lobe (weight 0: one lobe);
+// mie_phase_g too, which ReadTree requires for the kinds that use it.
 bool IsOptionalField(const std::string& name) {
-    return name == "mu_s_min" || name == "mie_phase_g2" || name == "mie_phase_weight2";
+    return name == "mu_s_min" || name == "mie_phase" || name == "mie_phase_g" ||
+           name == "mie_phase_g2" || name == "mie_phase_weight2";
 }
 
 const FieldSpec* FindField(const std::string& name) {
@@ -452,6 +465,163 @@ void ResolveSpectra(Json& root, const std::string& where, SpectralAtmosphere* ou
     }
 }
 
+// ---------------------------------------------------------------------------------------
+// The Mie phase function (docs/atmosphere.md "Mie phase functions"):
+//   "mie_phase": "cornette-shanks" | "henyey-greenstein" | "isotropic", or
+//   "mie_phase": {"kind": KIND} with, for "tabulated", one of
+//     "angles_deg": [...], "values": [...]       the nodes inline;
+//     "table": NAME (+ "column": i)              an embedded table of data/spectra/NAME.csv
+//                                                (first column the angle in deg);
+//     "file": PATH (+ "column": i)               a CSV file of the same form.
+
+const char kPhaseForms[] =
+    "mie_phase is \"cornette-shanks\", \"henyey-greenstein\", \"isotropic\" or "
+    "{\"kind\": \"tabulated\", \"angles_deg\": [...], \"values\": [...]} (or \"table\": NAME "
+    "or \"file\": PATH instead of the arrays, with an optional \"column\")";
+
+MiePhaseKind ParsePhaseKind(const Json& node, const std::string& where, const std::string& path) {
+    if (!node.is_string()) Fail(where, ": field '", path, "' must be a string (", kPhaseForms, ")");
+    const std::string name = node.get<std::string>();
+    for (MiePhaseKind kind : {MiePhaseKind::kCornetteShanks, MiePhaseKind::kHenyeyGreenstein,
+                              MiePhaseKind::kIsotropic, MiePhaseKind::kTabulated}) {
+        if (name == MiePhaseKindName(kind)) return kind;
+    }
+    Fail(where, ": field '", path, "' is '", name,
+         "' (kinds: cornette-shanks, henyey-greenstein, isotropic, tabulated)");
+}
+
+// The angle and value columns of a phase CSV's text: '#' comments, one header
+// line, then rows of numbers (the angle first).
+void ParsePhaseCsv(const std::string& text, int column, const std::string& where,
+                   const std::string& path, std::vector<double>* angles,
+                   std::vector<double>* values) {
+    std::string_view rest(text);
+    bool header = false;
+    int line_number = 0;
+    while (!rest.empty()) {
+        const size_t eol = rest.find('\n');
+        std::string_view line = rest.substr(0, eol);
+        rest = eol == std::string_view::npos ? std::string_view() : rest.substr(eol + 1);
+        ++line_number;
+        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+        if (line.empty() || line[0] == '#') continue;
+        if (!header) {
+            header = true;
+            continue;
+        }
+        std::vector<double> row;
+        size_t begin = 0;
+        while (true) {
+            const size_t comma = line.find(',', begin);
+            const std::string_view field = line.substr(
+                begin, comma == std::string_view::npos ? std::string_view::npos : comma - begin);
+            double v = 0.0;
+            const NumberError e = ParseNumber(field, &v);
+            if (e != NumberError::kNone) {
+                Fail(where, ": field '", path, "': line ", line_number, ": '", std::string(field),
+                     "' ", NumberErrorText(e));
+            }
+            row.push_back(v);
+            if (comma == std::string_view::npos) break;
+            begin = comma + 1;
+        }
+        if (static_cast<int>(row.size()) < column + 2) {
+            Fail(where, ": field '", path, "': line ", line_number, " has ", row.size(),
+                 " columns; the angle and value column ", column, " need ", column + 2);
+        }
+        angles->push_back(row[0]);
+        values->push_back(row[static_cast<size_t>(column) + 1]);
+    }
+}
+
+void ReadMiePhase(const Json& node, const std::string& where, AtmosphereParameters* a) {
+    const std::string path = "mie_phase";
+    if (node.is_string()) {
+        a->mie_phase_kind = ParsePhaseKind(node, where, path);
+        if (a->mie_phase_kind == MiePhaseKind::kTabulated) {
+            Fail(where, ": field 'mie_phase': a tabulated phase function needs its table (",
+                 kPhaseForms, ")");
+        }
+        return;
+    }
+    if (!node.is_object())
+        Fail(where, ": field 'mie_phase' must be a string or an object (", kPhaseForms, ")");
+    if (!node.contains("kind"))
+        Fail(where, ": field 'mie_phase.kind' is missing (", kPhaseForms, ")");
+    a->mie_phase_kind = ParsePhaseKind(node["kind"], where, path + ".kind");
+    if (a->mie_phase_kind != MiePhaseKind::kTabulated) {
+        CheckKeys(node, where, path, {"kind"});
+        return;
+    }
+    CheckKeys(node, where, path, {"kind", "angles_deg", "values", "table", "file", "column"});
+    const int sources = static_cast<int>(node.contains("angles_deg") || node.contains("values")) +
+                        static_cast<int>(node.contains("table")) +
+                        static_cast<int>(node.contains("file"));
+    if (sources != 1) {
+        Fail(where, ": field 'mie_phase' takes exactly one of angles_deg and values, table, file");
+    }
+    std::vector<double> angles, values;
+    if (node.contains("table") || node.contains("file")) {
+        int column = 0;
+        if (node.contains("column")) {
+            const double c = ReadNumber(node["column"], where, path + ".column");
+            if (!(c >= 0.0 && c <= 64.0) || c != std::floor(c)) {
+                Fail(where, ": field 'mie_phase.column' must be an integer in [0, 64]");
+            }
+            column = static_cast<int>(c);
+        }
+        if (node.contains("table")) {
+            if (!node["table"].is_string()) {
+                Fail(where, ": field 'mie_phase.table' must be a string (a table name)");
+            }
+            try {
+                SpectralDataTable(node["table"].get<std::string>(), column, &angles, &values);
+            } catch (const Error& e) {
+                Fail(where, ": field 'mie_phase.table': ", e.what());
+            }
+        } else {
+            if (!node["file"].is_string()) {
+                Fail(where, ": field 'mie_phase.file' must be a string (a CSV file's path)");
+            }
+            const std::string file = node["file"].get<std::string>();
+            std::string text;
+            try {
+                text = ReadFileBounded(file, size_t{1} << 20, 4096);
+            } catch (const Error& e) {
+                Fail(where, ": field 'mie_phase.file': ", e.what());
+            }
+            ParsePhaseCsv(text, column, where, path + ".file", &angles, &values);
+        }
+    } else {
+        if (node.contains("column")) {
+            Fail(where, ": field 'mie_phase.column' goes with table or file");
+        }
+        if (!node.contains("angles_deg")) Fail(where, ": field 'mie_phase.angles_deg' is missing");
+        if (!node.contains("values")) Fail(where, ": field 'mie_phase.values' is missing");
+        angles = ReadNumberArray(node["angles_deg"], where, path + ".angles_deg");
+        values = ReadNumberArray(node["values"], where, path + ".values");
+    }
+    if (angles.size() != values.size()) {
+        Fail(where, ": field 'mie_phase': angles_deg has ", angles.size(), " entries and values ",
+             values.size());
+    }
+    if (angles.size() < 2 || angles.size() > static_cast<size_t>(kMaxMiePhaseNodes)) {
+        Fail(where, ": field 'mie_phase': a tabulated phase function has 2 to ", kMaxMiePhaseNodes,
+             " nodes, not ", angles.size());
+    }
+    MiePhaseTable& t = a->mie_phase_table;
+    t.count = static_cast<int>(angles.size());
+    for (int i = 0; i < t.count; ++i) {
+        t.angle_deg[i] = angles[static_cast<size_t>(i)];
+        t.value[i] = values[static_cast<size_t>(i)];
+    }
+    try {
+        FinishMiePhaseTable(&t, path);
+    } catch (const Error& e) {
+        Fail(where, ": ", e.what());
+    }
+}
+
 AtmosphereParameters ReadTree(const Json& root, const std::string& where) {
     if (!root.is_object()) Fail(where, ": the top level must be a JSON object");
     for (const auto& item : root.items()) {
@@ -479,12 +649,26 @@ AtmosphereParameters ReadTree(const Json& root, const std::string& where) {
     a.mie_scattering = ReadRgb(root["mie_scattering"], where, "mie_scattering");
     a.mie_extinction = ReadRgb(root["mie_extinction"], where, "mie_extinction");
     a.mie_density = ReadDensity(root["mie_density"], where, "mie_density");
-    a.mie_phase_g = ReadNumber(root["mie_phase_g"], where, "mie_phase_g");
-    if (root.contains("mie_phase_g2")) {
-        a.mie_phase_g2 = ReadNumber(root["mie_phase_g2"], where, "mie_phase_g2");
-    }
-    if (root.contains("mie_phase_weight2")) {
-        a.mie_phase_weight2 = ReadNumber(root["mie_phase_weight2"], where, "mie_phase_weight2");
+    if (root.contains("mie_phase")) ReadMiePhase(root["mie_phase"], where, &a);
+    if (a.mie_phase_kind == MiePhaseKind::kCornetteShanks ||
+        a.mie_phase_kind == MiePhaseKind::kHenyeyGreenstein) {
+        if (!root.contains("mie_phase_g")) Fail(where, ": field 'mie_phase_g' is missing");
+        a.mie_phase_g = ReadNumber(root["mie_phase_g"], where, "mie_phase_g");
+        if (root.contains("mie_phase_g2")) {
+            a.mie_phase_g2 = ReadNumber(root["mie_phase_g2"], where, "mie_phase_g2");
+        }
+        if (root.contains("mie_phase_weight2")) {
+            a.mie_phase_weight2 = ReadNumber(root["mie_phase_weight2"], where, "mie_phase_weight2");
+        }
+    } else {
+        // Isotropic and tabulated phase functions have no lobes: the lobe fields
+        // are not read (so that --set mie_phase=... works on any preset);
+        // mie_phase_g is the function's mean cosine, for models that take an
+        // asymmetry parameter.
+        a.mie_phase_g =
+            a.mie_phase_kind == MiePhaseKind::kTabulated ? a.mie_phase_table.mean_cosine : 0.0;
+        a.mie_phase_g2 = 0.0;
+        a.mie_phase_weight2 = 0.0;
     }
     a.absorption_extinction =
         ReadRgb(root["absorption_extinction"], where, "absorption_extinction");
@@ -633,6 +817,25 @@ void ApplyOverride(Json& root, const std::string& text, const std::string& where
     const std::vector<std::string> path = Split(field, '.');
     const FieldSpec* spec = FindField(path[0]);
     if (spec == nullptr) FailUnknownField(field, text, "");
+    if (spec->kind == FieldKind::kPhase) {
+        // --set mie_phase=KIND (a bare name) or --set mie_phase=JSON, or
+        // --set mie_phase.KEY=VALUE on an object (e.g. mie_phase.column=1).
+        const std::string value_text = Trim(text.substr(eq + 1));
+        Json value = Json::parse(value_text, nullptr, /*allow_exceptions=*/false);
+        if (value.is_discarded()) value = value_text;
+        Json& node = root[path[0]];
+        if (path.size() == 1) {
+            node = value;
+            return;
+        }
+        if (path.size() == 2 && node.is_object()) {
+            node[path[1]] = value;
+            return;
+        }
+        FailUnknownField(field, text,
+                         "; mie_phase takes mie_phase=KIND, mie_phase=JSON or, "
+                         "on an object, mie_phase.KEY=VALUE");
+    }
     const Json value = ParseOverrideValue(text.substr(eq + 1), text);
     Json& node = root[path[0]];
     if (path.size() == 1) {
@@ -735,12 +938,31 @@ std::string AtmosphereToJson(const AtmosphereParameters& a) {
     root["mie_scattering"] = RgbToJson(a.mie_scattering);
     root["mie_extinction"] = RgbToJson(a.mie_extinction);
     root["mie_density"] = DensityToJson(a.mie_density);
-    root["mie_phase_g"] = a.mie_phase_g;
-    // The second lobe only when there is one, so that one-lobe atmospheres
-    // (every preset but kider-2013-aeronet) keep their text and fingerprints.
-    if (a.mie_phase_weight2 != 0.0 || a.mie_phase_g2 != 0.0) {
-        root["mie_phase_g2"] = a.mie_phase_g2;
-        root["mie_phase_weight2"] = a.mie_phase_weight2;
+    // The kind only when it is not the default Cornette-Shanks, and the lobe
+    // fields only for the kinds with lobes, so that Cornette-Shanks atmospheres
+    // keep their text and fingerprints; a tabulated function is written inline,
+    // its nodes as given (the reader renormalises them the same way again).
+    const MiePhaseKind kind = a.mie_phase_kind;
+    if (kind == MiePhaseKind::kTabulated) {
+        const MiePhaseTable& t = a.mie_phase_table;
+        Json angles = Json::array(), values = Json::array();
+        for (int i = 0; i < t.count; ++i) {
+            angles.push_back(t.angle_deg[i]);
+            values.push_back(t.value[i]);
+        }
+        root["mie_phase"] = Json::object(
+            {{"kind", MiePhaseKindName(kind)}, {"angles_deg", angles}, {"values", values}});
+    } else if (kind != MiePhaseKind::kCornetteShanks) {
+        root["mie_phase"] = MiePhaseKindName(kind);
+    }
+    if (kind == MiePhaseKind::kCornetteShanks || kind == MiePhaseKind::kHenyeyGreenstein) {
+        root["mie_phase_g"] = a.mie_phase_g;
+        // The second lobe only when there is one, so that one-lobe atmospheres
+        // (every preset but kider-2013-aeronet) keep their text and fingerprints.
+        if (a.mie_phase_weight2 != 0.0 || a.mie_phase_g2 != 0.0) {
+            root["mie_phase_g2"] = a.mie_phase_g2;
+            root["mie_phase_weight2"] = a.mie_phase_weight2;
+        }
     }
     root["absorption_extinction"] = RgbToJson(a.absorption_extinction);
     root["absorption_density"] = DensityToJson(a.absorption_density);

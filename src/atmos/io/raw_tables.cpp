@@ -127,6 +127,26 @@ void WriteGlslAtmosphere(std::ostream& s, const AtmosphereParameters& a) {
     s << "#define ATMOS_BOTTOM_RADIUS " << a.bottom_radius << "\n";
     s << "#define ATMOS_TOP_RADIUS " << a.top_radius << "\n";
     s << "#define ATMOS_MIE_PHASE_G " << a.mie_phase_g << "\n";
+    if (a.mie_phase_kind != MiePhaseKind::kCornetteShanks) {
+        // The phase function's kind (common.glsl atmos_MiePhase; atmosphere.h
+        // MiePhaseKind); absent for Cornette-Shanks, so those constants are as before.
+        s << "#define ATMOS_MIE_PHASE_KIND " << static_cast<int>(a.mie_phase_kind) << "\n";
+    }
+    if (a.mie_phase_kind == MiePhaseKind::kTabulated) {
+        // The table as two constant arrays: the nodes' cosines and the normalised
+        // values (1/sr), linear in nu between nodes as physics/phase.h TabulatedPhase.
+        const MiePhaseTable& t = a.mie_phase_table;
+        s << "#define ATMOS_MIE_PHASE_TABLE_COUNT " << t.count << "\n";
+        for (int array = 0; array < 2; ++array) {
+            s << "const float "
+              << (array == 0 ? "atmos_MiePhaseTableMu" : "atmos_MiePhaseTableValue") << "["
+              << t.count << "] = float[" << t.count << "](";
+            for (int i = 0; i < t.count; ++i) {
+                s << (i == 0 ? "" : ", ") << (array == 0 ? t.mu[i] : t.value[i] * t.scale);
+            }
+            s << ");\n";
+        }
+    }
     if (a.mie_phase_weight2 != 0.0) {
         // The second Cornette-Shanks lobe (common.glsl atmos_MiePhase); absent
         // for one lobe, so one-lobe constants are as before.

@@ -363,6 +363,37 @@ ATMOS_HD inline void BrunetonPhaseSums(const BrunetonDirections& grid, const flo
     *sum_mie = sm;
 }
 
+// BrunetonPhaseSums for any Mie phase function (physics/phase.h MiePhase, in
+// double per direction): the Rayleigh sums as there (1 + x^2), the Mie sums
+// with the normalised phase itself.
+ATMOS_HD inline void BrunetonPhaseSumsGeneric(const BrunetonDirections& grid, const float* l,
+                                              float ox, float oy, float oz,
+                                              const AtmosphereParameters& atm, Rgb* sum_rayleigh,
+                                              Rgb* sum_mie) {
+    const float* l0 = l;
+    const float* l1 = l + kBrunetonDirections;
+    const float* l2 = l + 2 * kBrunetonDirections;
+    double ar[3] = {}, am[3] = {};
+    for (int k = 0; k < kBrunetonDirections; ++k) {
+        const double x = static_cast<double>(ox * grid.wx[k] + oy * grid.wy[k] + oz * grid.wz[k]);
+        const double pr = 1.0 + x * x;
+        const double pm = MiePhase(atm, x);
+        const double v0 = static_cast<double>(l0[k]);
+        const double v1 = static_cast<double>(l1[k]);
+        const double v2 = static_cast<double>(l2[k]);
+        ar[0] += pr * v0;
+        ar[1] += pr * v1;
+        ar[2] += pr * v2;
+        am[0] += pm * v0;
+        am[1] += pm * v1;
+        am[2] += pm * v2;
+    }
+    for (int ch = 0; ch < 3; ++ch) {
+        (*sum_rayleigh)[ch] = static_cast<float>(ar[ch]);
+        (*sum_mie)[ch] = static_cast<float>(am[ch]);
+    }
+}
+
 // J_n per texel of the scattering table: the phase-weighted sums of the
 // incident table times the scattering coefficients (3 channels).
 struct BrunetonDensityStage {
@@ -392,6 +423,19 @@ struct BrunetonDensityStage {
             incident.data + (static_cast<size_t>(z) * incident.height + static_cast<size_t>(s)) *
                                 static_cast<size_t>(incident.width);
         Rgb sum_r, sum_m;
+        if (atm.mie_phase_kind != MiePhaseKind::kCornetteShanks) {
+            // Any other phase function (Henyey-Greenstein, isotropic, tabulated):
+            // the sums with MiePhase itself (normalised, so no k_m).
+            BrunetonPhaseSumsGeneric(BrunetonDirections(directions), l, static_cast<float>(ox),
+                                     static_cast<float>(oy), static_cast<float>(mu), atm, &sum_r,
+                                     &sum_m);
+            const double alt = r - atm.bottom_radius;
+            const Vec3d br = atm.rayleigh_scattering *
+                             (GetProfileDensity(atm.rayleigh_density, alt) * (3.0 / (16.0 * kPi)));
+            const Vec3d bm = atm.mie_scattering * GetProfileDensity(atm.mie_density, alt);
+            density.Set(x, y, z, BrunetonVec4(sum_r * Rgb(br) + sum_m * Rgb(bm)));
+            return;
+        }
         BrunetonPhaseSums(BrunetonDirections(directions), l, static_cast<float>(ox),
                           static_cast<float>(oy), static_cast<float>(mu), static_cast<float>(g),
                           &sum_r, &sum_m);

@@ -259,6 +259,11 @@ NeuralWeights EmbeddedNeuralWeights(const std::string& name) {
 }
 
 void CheckNeuralSingleMieLobe(const AtmosphereParameters& a) {
+    if (a.mie_phase_kind != MiePhaseKind::kCornetteShanks) {
+        Fail("neural: the atmosphere's mie_phase is ", MiePhaseKindName(a.mie_phase_kind),
+             ": the network's input encoding carries one Cornette-Shanks lobe (mie_phase_g), so "
+             "neural takes only the cornette-shanks kind");
+    }
     if (a.mie_phase_weight2 != 0.0) {
         Fail("neural: the atmosphere's mie_phase_weight2 is ", a.mie_phase_weight2,
              ": the network's input encoding carries one Cornette-Shanks lobe (mie_phase_g), so "

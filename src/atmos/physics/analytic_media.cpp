@@ -42,6 +42,8 @@ AnalyticMedia MakeAnalyticMedia(const AtmosphereParameters& atm) {
     m.mie_g = atm.mie_phase_g;
     m.mie_g2 = atm.mie_phase_g2;
     m.mie_w2 = atm.mie_phase_weight2;
+    m.mie_kind = atm.mie_phase_kind;
+    m.mie_table = atm.mie_phase_table;
     m.ground_albedo = atm.ground_albedo;
     return m;
 }

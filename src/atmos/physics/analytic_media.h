@@ -27,16 +27,20 @@ struct AnalyticMedia {
     Vec3d ozone_absorption;  // 1/m inside the shell
     OzoneShell ozone;
     double mie_g = 0.8;
-    double mie_g2 = 0.0;  // the second Cornette-Shanks lobe (MiePhase)
+    double mie_g2 = 0.0;  // the second lobe (MiePhase)
     double mie_w2 = 0.0;  // its weight
+    MiePhaseKind mie_kind = MiePhaseKind::kCornetteShanks;
+    MiePhaseTable mie_table;  // a tabulated phase function (mie_kind kTabulated)
     Vec3d ground_albedo;
 
     ATMOS_HD Vec3d Extinction(double l_rayleigh, double l_mie, double l_ozone) const {
         return rayleigh_scattering * l_rayleigh + mie_extinction * l_mie +
                ozone_absorption * l_ozone;
     }
-    // The atmosphere's Mie phase (one or two Cornette-Shanks lobes: phase.h).
-    ATMOS_HD double MiePhaseAt(double nu) const { return MiePhase(mie_g, mie_g2, mie_w2, nu); }
+    // The atmosphere's Mie phase (any kind: phase.h MiePhase).
+    ATMOS_HD double MiePhaseAt(double nu) const {
+        return MiePhase(mie_kind, mie_g, mie_g2, mie_w2, mie_table, nu);
+    }
 };
 
 AnalyticMedia MakeAnalyticMedia(const AtmosphereParameters& atm);

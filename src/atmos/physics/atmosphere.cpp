@@ -84,6 +84,82 @@ void CheckProfile(const std::string& field, const DensityProfile& profile) {
 
 }  // namespace
 
+const char* MiePhaseKindName(MiePhaseKind kind) {
+    switch (kind) {
+        case MiePhaseKind::kHenyeyGreenstein:
+            return "henyey-greenstein";
+        case MiePhaseKind::kIsotropic:
+            return "isotropic";
+        case MiePhaseKind::kTabulated:
+            return "tabulated";
+        case MiePhaseKind::kCornetteShanks:
+        default:
+            return "cornette-shanks";
+    }
+}
+
+// The phase is linear in mu between nodes (atmosphere.h MiePhaseTable), so over
+// the interval [a, b] = [mu[i+1], mu[i]] with values va, vb the integrals are
+// exact: of the value, (b - a)(va + vb) / 2; of mu times the value,
+// (b - a)((2a + b) va + (a + 2b) vb) / 6; times 2 pi for the azimuth.
+void FinishMiePhaseTable(MiePhaseTable* t, const std::string& field) {
+    const int n = t->count;
+    if (n < 2 || n > kMaxMiePhaseNodes) {
+        Fail("invalid atmosphere field '", field, "': a tabulated phase function has 2 to ",
+             kMaxMiePhaseNodes, " nodes, not ", n);
+    }
+    for (int i = 0; i < n; ++i) {
+        const std::string at = "[" + std::to_string(i) + "]";
+        const double angle = t->angle_deg[i];
+        const double value = t->value[i];
+        if (!std::isfinite(angle) || angle < 0.0 || angle > 180.0) {
+            FailField(field + ".angles_deg" + at, angle, "[0, 180] (deg)");
+        }
+        if (!std::isfinite(value) || !(value > 0.0) || value > 1e30) {
+            FailField(field + ".values" + at, value, "(0, 1e+30] (a phase function is positive)");
+        }
+    }
+    if (t->angle_deg[0] != 0.0) {
+        Fail("invalid atmosphere field '", field,
+             ".angles_deg[0]': ", FormatNumber(t->angle_deg[0]),
+             " (the first angle must be 0: the table covers 0 to 180 deg)");
+    }
+    if (t->angle_deg[n - 1] != 180.0) {
+        Fail("invalid atmosphere field '", field, ".angles_deg[", n - 1,
+             "]': ", FormatNumber(t->angle_deg[n - 1]),
+             " (the last angle must be 180: the table covers 0 to 180 deg)");
+    }
+    for (int i = 0; i < n; ++i) {
+        t->mu[i] = i == 0 ? 1.0 : i == n - 1 ? -1.0 : std::cos(t->angle_deg[i] * (kPi / 180.0));
+        if (i > 0 && !(t->angle_deg[i] > t->angle_deg[i - 1] && t->mu[i] < t->mu[i - 1])) {
+            Fail("invalid atmosphere field '", field, ".angles_deg[", i,
+                 "]': ", FormatNumber(t->angle_deg[i]), " after ",
+                 FormatNumber(t->angle_deg[i - 1]),
+                 " (the angles must increase strictly, with distinct cosines)");
+        }
+    }
+    double integral = 0.0, first_moment = 0.0;
+    double mass[kMaxMiePhaseNodes] = {};
+    for (int i = 0; i + 1 < n; ++i) {
+        const double a = t->mu[i + 1], b = t->mu[i];
+        const double va = t->value[i + 1], vb = t->value[i];
+        mass[i] = 2.0 * kPi * (b - a) * 0.5 * (va + vb);
+        integral += mass[i];
+        first_moment += 2.0 * kPi * (b - a) * ((2.0 * a + b) * va + (a + 2.0 * b) * vb) / 6.0;
+    }
+    t->scale = 1.0 / integral;
+    t->mean_cosine = first_moment / integral;
+    double cumulative = 0.0;
+    t->cdf[0] = 0.0;
+    for (int i = 0; i + 1 < n; ++i) {
+        cumulative += mass[i];
+        t->cdf[i + 1] = i + 2 == n ? 1.0 : cumulative / integral;
+    }
+    for (int i = n; i < kMaxMiePhaseNodes; ++i) {
+        t->angle_deg[i] = t->value[i] = t->mu[i] = t->cdf[i] = 0.0;
+    }
+}
+
 // One exponential exp(-h / H): Bruneton's 2017 implementation notes' rayleigh_layer / mie_layer
 // (DensityProfileLayer(0, 1, -1/H, 0, 0)) in layers[1]; layers[0] has width 0
 // so it never applies.
@@ -169,6 +245,28 @@ void ValidateAtmosphere(const AtmosphereParameters& a) {
     CheckRange("mie_phase_g", a.mie_phase_g, -1.0, true, 1.0, true, "(-1, 1)");
     CheckRange("mie_phase_g2", a.mie_phase_g2, -1.0, true, 1.0, true, "(-1, 1)");
     CheckRange("mie_phase_weight2", a.mie_phase_weight2, 0.0, false, 1.0, false, "[0, 1]");
+    switch (a.mie_phase_kind) {
+        case MiePhaseKind::kCornetteShanks:
+        case MiePhaseKind::kHenyeyGreenstein:
+        case MiePhaseKind::kIsotropic:
+            break;
+        case MiePhaseKind::kTabulated: {
+            // The derived members must be those of the table (FinishMiePhaseTable).
+            MiePhaseTable check = a.mie_phase_table;
+            FinishMiePhaseTable(&check, "mie_phase");
+            if (check.scale != a.mie_phase_table.scale ||
+                check.mean_cosine != a.mie_phase_table.mean_cosine) {
+                Fail(
+                    "invalid atmosphere field 'mie_phase': the table's normalisation is stale "
+                    "(FinishMiePhaseTable was not called after changing it)");
+            }
+            break;
+        }
+        default:
+            Fail("invalid atmosphere field 'mie_phase': unknown kind ",
+                 static_cast<int>(a.mie_phase_kind),
+                 " (cornette-shanks, henyey-greenstein, isotropic or tabulated)");
+    }
     CheckCoefficient("absorption_extinction", a.absorption_extinction);
     CheckProfile("absorption_density", a.absorption_density);
     CheckRgbRange("ground_albedo", a.ground_albedo, 0.0, 1.0, "[0, 1]");

@@ -13,8 +13,11 @@
 //                     (Leenman's 2025 thesis Eq. 6 writes +2g cos theta with theta measured
 //                      from the backward direction; here nu = +cos of the angle
 //                      between propagation directions, so forward peaks at nu = 1)
-//   Mie:              (1 - w) CS(g) + w CS(g2)                 MiePhase (two lobes)
+//   Mie:              (1 - w) CS(g) + w CS(g2)                 MiePhase (two lobes), or
+//                     (1 - w) HG(g) + w HG(g2), isotropic or tabulated (mie_phase_kind)
 //   isotropic:        1/(4 pi)                                  Leenman's 2025 thesis Eq. 7
+//   tabulated:        values at scattering angles, linear in nu between them, normalised
+//                     so that the integral over the sphere is 1 (atmosphere.h MiePhaseTable)
 #pragma once
 
 #include "atmos/atmosphere.h"
@@ -40,15 +43,62 @@ ATMOS_HD inline double MiePhase(double g, double g2, double w, double nu) {
     return (1.0 - w) * p + w * CornetteShanksPhase(g2, nu);
 }
 
-ATMOS_HD inline double MiePhase(const AtmosphereParameters& atm, double nu) {
-    return MiePhase(atm.mie_phase_g, atm.mie_phase_g2, atm.mie_phase_weight2, nu);
-}
-
 ATMOS_HD inline double HenyeyGreensteinPhase(double g, double nu) {
     const double denom = 1.0 + g * g - 2.0 * g * nu;
     return (1.0 - g * g) / (4.0 * kPi * denom * Sqrt(denom));
 }
 
 ATMOS_HD inline double IsotropicPhase() { return 1.0 / (4.0 * kPi); }
+
+// The interval of a tabulated phase function that holds nu: the i with
+// mu[i] >= nu >= mu[i + 1] (0 <= i <= count - 2; mu decreases from 1 to -1).
+ATMOS_HD inline int MiePhaseTableInterval(const MiePhaseTable& t, double nu) {
+    int lo = 0, hi = t.count - 1;  // mu[lo] >= nu >= mu[hi]
+    while (hi - lo > 1) {
+        const int mid = (lo + hi) / 2;
+        if (t.mu[mid] >= nu) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// A tabulated phase function (atmosphere.h MiePhaseTable): the values linear in
+// nu between the nodes, times the table's normalisation (1/sr).
+ATMOS_HD inline double TabulatedPhase(const MiePhaseTable& t, double nu) {
+    nu = Clamp(nu, -1.0, 1.0);
+    const int i = MiePhaseTableInterval(t, nu);
+    const double h = t.mu[i] - t.mu[i + 1];
+    const double f = h > 0.0 ? (t.mu[i] - nu) / h : 0.0;
+    return t.scale * (t.value[i] + (t.value[i + 1] - t.value[i]) * f);
+}
+
+// Any Mie phase function (AtmosphereParameters::mie_phase_kind): Cornette-Shanks
+// or Henyey-Greenstein lobes (1 - w) P(g) + w P(g2) (w = 0: P(g) alone, the
+// second lobe not evaluated), isotropic, or tabulated.
+ATMOS_HD inline double MiePhase(MiePhaseKind kind, double g, double g2, double w,
+                                const MiePhaseTable& table, double nu) {
+    switch (kind) {
+        case MiePhaseKind::kHenyeyGreenstein: {
+            const double p = HenyeyGreensteinPhase(g, nu);
+            if (w == 0.0) return p;
+            return (1.0 - w) * p + w * HenyeyGreensteinPhase(g2, nu);
+        }
+        case MiePhaseKind::kIsotropic:
+            return IsotropicPhase();
+        case MiePhaseKind::kTabulated:
+            return TabulatedPhase(table, nu);
+        case MiePhaseKind::kCornetteShanks:
+        default:
+            return MiePhase(g, g2, w, nu);
+    }
+}
+
+ATMOS_HD inline double MiePhase(const AtmosphereParameters& atm, double nu) {
+    return MiePhase(atm.mie_phase_kind, atm.mie_phase_g, atm.mie_phase_g2, atm.mie_phase_weight2,
+                    atm.mie_phase_table, nu);
+}
 
 }  // namespace atmos

@@ -35,21 +35,60 @@ ATMOS_HD inline double CornetteShanksOverHenyeyGreenstein(double g, double mu) {
     return 1.5 * (1.0 + mu * mu) / (2.0 + g * g);
 }
 
-// The Mie phase (physics/phase.h MiePhase, one or two Cornette-Shanks lobes)
-// sampled by the mixture of the lobes' Henyey-Greenstein functions: lobe 2
-// with probability w (then HG(g2)), else lobe 1 (HG(g)); one uniform number,
+// A tabulated phase function (atmosphere.h MiePhaseTable) sampled exactly by
+// its inverse CDF: the interval i with cdf[i] <= xi < cdf[i + 1] (binary
+// search), then inside it the phase is linear in mu, so the mass between mu[i]
+// and mu is a quadratic in t = mu[i] - mu,
+//   2 pi scale (v_i t + (v_{i+1} - v_i) t^2 / (2 h)) = xi - cdf[i]   (h = mu[i] - mu[i+1]),
+// solved as t = 2 c / (v_i + sqrt(v_i^2 + 4 k c)) with c = (xi - cdf[i]) / (2 pi scale) and
+// k = (v_{i+1} - v_i) / (2 h) (the form without cancellation; v > 0 keeps the root real).
+// The density of the result is TabulatedPhase itself.
+ATMOS_HD inline double SampleTabulatedPhaseCosine(const MiePhaseTable& t, double xi) {
+    int lo = 0, hi = t.count - 1;  // cdf[lo] <= xi < cdf[hi]
+    while (hi - lo > 1) {
+        const int mid = (lo + hi) / 2;
+        if (t.cdf[mid] <= xi) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    const double h = t.mu[lo] - t.mu[lo + 1];
+    const double v0 = t.value[lo];
+    const double k = (t.value[lo + 1] - v0) / (2.0 * h);
+    const double c = Max(xi - t.cdf[lo], 0.0) / (2.0 * kPi * t.scale);
+    const double disc = Max(v0 * v0 + 4.0 * k * c, 0.0);
+    const double step = Clamp(2.0 * c / (v0 + Sqrt(disc)), 0.0, h);
+    return Clamp(t.mu[lo] - step, -1.0, 1.0);
+}
+
+// The Mie phase (physics/phase.h MiePhase) sampled. Cornette-Shanks lobes: by
+// the mixture of the lobes' Henyey-Greenstein functions: lobe 2 with
+// probability w (then HG(g2)), else lobe 1 (HG(g)); one uniform number,
 // rescaled after the choice, so that w = 0 draws exactly as HG(g) alone.
+// Henyey-Greenstein lobes: the same mixture, which is then the phase itself;
+// isotropic: mu = 1 - 2 xi; tabulated: SampleTabulatedPhaseCosine. So every
+// kind but Cornette-Shanks is sampled exactly (weight 1).
 ATMOS_HD inline double SampleMiePhaseCosine(const AtmosphereParameters& atm, double xi) {
+    switch (atm.mie_phase_kind) {
+        case MiePhaseKind::kIsotropic:
+            return 1.0 - 2.0 * xi;
+        case MiePhaseKind::kTabulated:
+            return SampleTabulatedPhaseCosine(atm.mie_phase_table, xi);
+        default:
+            break;
+    }
     const double w = atm.mie_phase_weight2;
     if (w == 0.0) return SampleHenyeyGreensteinCosine(atm.mie_phase_g, xi);
     if (xi < w) return SampleHenyeyGreensteinCosine(atm.mie_phase_g2, xi / w);
     return SampleHenyeyGreensteinCosine(atm.mie_phase_g, (xi - w) / (1.0 - w));
 }
 
-// The density of SampleMiePhaseCosine's directions (per steradian):
-// (1 - w) HG(g, mu) + w HG(g2, mu) (one-sample MIS over the lobes, balance
-// heuristic).
+// The density of SampleMiePhaseCosine's directions (per steradian): for
+// Cornette-Shanks (1 - w) HG(g, mu) + w HG(g2, mu) (one-sample MIS over the
+// lobes, balance heuristic); for the other kinds the phase function itself.
 ATMOS_HD inline double MiePhaseSamplingPdf(const AtmosphereParameters& atm, double mu) {
+    if (atm.mie_phase_kind != MiePhaseKind::kCornetteShanks) return MiePhase(atm, mu);
     const double w = atm.mie_phase_weight2;
     const double p = HenyeyGreensteinPhase(atm.mie_phase_g, mu);
     if (w == 0.0) return p;
@@ -57,9 +96,11 @@ ATMOS_HD inline double MiePhaseSamplingPdf(const AtmosphereParameters& atm, doub
 }
 
 // The weight MiePhase / MiePhaseSamplingPdf of a SampleMiePhaseCosine sample:
-// with one lobe CornetteShanksOverHenyeyGreenstein; with two a ratio of
-// mixtures with the same weights, so at most the larger lobe ratio (<= 1.5).
+// with one Cornette-Shanks lobe CornetteShanksOverHenyeyGreenstein; with two a
+// ratio of mixtures with the same weights, so at most the larger lobe ratio
+// (<= 1.5); 1 for the kinds sampled exactly.
 ATMOS_HD inline double MiePhaseOverSamplingPdf(const AtmosphereParameters& atm, double mu) {
+    if (atm.mie_phase_kind != MiePhaseKind::kCornetteShanks) return 1.0;
     if (atm.mie_phase_weight2 == 0.0) {
         return CornetteShanksOverHenyeyGreenstein(atm.mie_phase_g, mu);
     }

@@ -151,6 +151,12 @@ AerosolFit FitAerosol(const AerosolFitSettings& settings, const std::string& atm
                 "--fit needs an exponential aerosol (mie_density {\"scale_height\": H}) with a "
                 "positive Mie extinction");
         }
+        if (a.base.mie_phase_kind == MiePhaseKind::kIsotropic ||
+            a.base.mie_phase_kind == MiePhaseKind::kTabulated) {
+            Fail("--fit fits mie_phase_g, which a ", MiePhaseKindName(a.base.mie_phase_kind),
+                 " mie_phase does not use: fit with a cornette-shanks or henyey-greenstein "
+                 "mie_phase");
+        }
         fit.start_values[0] = e1000 / -scale;
         fit.start_values[1] = std::log(e500 / e1000) / std::log(2.0);
         fit.start_values[2] = a.mie_scattering.At(550.0) / a.mie_extinction.At(550.0);
