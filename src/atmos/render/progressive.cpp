@@ -210,10 +210,13 @@ void CommitCheckpoint(const std::string& path, const std::string& bytes) {
         ::unlink(tmp.c_str());
         throw;
     }
-    if (::fsync(fd) != 0 || ::close(fd) != 0) {
-        const int err = errno;
+    const bool synced = ::fsync(fd) == 0;
+    int sync_error = errno;
+    const bool closed = ::close(fd) == 0;  // closed whether or not the fsync failed
+    if (synced && !closed) sync_error = errno;
+    if (!synced || !closed) {
         ::unlink(tmp.c_str());
-        Fail("cannot write checkpoint '", path, "': ", std::strerror(err));
+        Fail("cannot write checkpoint '", path, "': ", std::strerror(sync_error));
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
         const int err = errno;
