@@ -195,6 +195,7 @@ void WriteMultiChannelExr(const std::string& path, int width, int height,
 }
 
 Image ReadExr(const std::string& path) {
+    RequireRegularInput(path, "EXR");  // OpenEXR opens by name: a FIFO would block it
     try {
         return ReadExrImpl(path);
     } catch (const Error&) {

@@ -164,6 +164,7 @@ void WritePngBytes(const std::vector<std::uint8_t>& bytes, int width, int height
 }
 
 Image ReadPng(const std::string& path) {
+    RequireRegularInput(path, "PNG");  // a FIFO no one writes would block the open
     errno = 0;
     FilePtr file(std::fopen(path.c_str(), "rb"));
     if (!file) Fail("cannot open '", path, "' for reading: ", std::strerror(errno));

@@ -31,6 +31,10 @@ namespace atmos {
 
 namespace {
 
+// The most paths per pixel (and per pass): 2^32, far beyond any render, and
+// far from where the pass arithmetic overflows.
+constexpr int64_t kMaxMonteCarloSpp = int64_t{1} << 32;
+
 void RequireMonteCarlo(const Model& model) {
     if (!model.Info().capabilities.stochastic) {
         Fail("model ", model.Info().name,
@@ -39,8 +43,15 @@ void RequireMonteCarlo(const Model& model) {
 }
 
 void CheckSettings(const MonteCarloSettings& mc) {
-    if (mc.spp < 1) Fail("Monte Carlo render: spp must be at least 1, got ", mc.spp);
-    if (mc.pass_spp < 0) Fail("Monte Carlo render: pass spp must be >= 0, got ", mc.pass_spp);
+    // Bounded so that the pass arithmetic cannot overflow (a --spp near 2^63
+    // rendered nothing in 0 s and exited 0).
+    if (mc.spp < 1 || mc.spp > kMaxMonteCarloSpp) {
+        Fail("Monte Carlo render: spp must be in [1, ", kMaxMonteCarloSpp, "], got ", mc.spp);
+    }
+    if (mc.pass_spp < 0 || mc.pass_spp > kMaxMonteCarloSpp) {
+        Fail("Monte Carlo render: pass spp must be in [0, ", kMaxMonteCarloSpp, "], got ",
+             mc.pass_spp);
+    }
     if (!(mc.noise_target >= 0.0) || mc.noise_target >= 1.0) {
         Fail("Monte Carlo render: the noise target must be in (0, 1) (0: off), got ",
              mc.noise_target);
@@ -388,10 +399,16 @@ MonteCarloSettings MakeMonteCarloSettings(int64_t spp, int64_t seed, int64_t pas
                                           const char* spp_flag, const char* seed_flag,
                                           const char* pass_flag) {
     if (spp < 1) Fail(spp_flag, " must be at least 1, got ", spp);
+    if (spp > kMaxMonteCarloSpp) {
+        Fail(spp_flag, " must be at most ", kMaxMonteCarloSpp, " (2^32) paths, got ", spp);
+    }
     if (seed < 0 || seed > 4294967295ll) {
         Fail(seed_flag, " must be in [0, 4294967295], got ", seed);
     }
-    if (pass_spp < 0) Fail(pass_flag, " must be >= 0 (0: spp/8 in [1, 64]), got ", pass_spp);
+    if (pass_spp < 0 || pass_spp > kMaxMonteCarloSpp) {
+        Fail(pass_flag, " must be in [0, ", kMaxMonteCarloSpp, "] (0: spp/8 in [1, 64]), got ",
+             pass_spp);
+    }
     MonteCarloSettings mc;
     mc.spp = spp;
     mc.seed = static_cast<uint64_t>(seed);
