@@ -45,11 +45,13 @@ void RequireMonteCarlo(const Model& model) {
 void CheckSettings(const MonteCarloSettings& mc) {
     // Bounded so that the pass arithmetic cannot overflow (a --spp near 2^63
     // rendered nothing in 0 s and exited 0).
-    if (mc.spp < 1 || mc.spp > kMaxMonteCarloSpp) {
-        Fail("Monte Carlo render: spp must be in [1, ", kMaxMonteCarloSpp, "], got ", mc.spp);
+    if (mc.spp < 1) Fail("Monte Carlo render: spp must be at least 1, got ", mc.spp);
+    if (mc.spp > kMaxMonteCarloSpp) {
+        Fail("Monte Carlo render: spp must be at most ", kMaxMonteCarloSpp, ", got ", mc.spp);
     }
-    if (mc.pass_spp < 0 || mc.pass_spp > kMaxMonteCarloSpp) {
-        Fail("Monte Carlo render: pass spp must be in [0, ", kMaxMonteCarloSpp, "], got ",
+    if (mc.pass_spp < 0) Fail("Monte Carlo render: pass spp must be >= 0, got ", mc.pass_spp);
+    if (mc.pass_spp > kMaxMonteCarloSpp) {
+        Fail("Monte Carlo render: pass spp must be at most ", kMaxMonteCarloSpp, ", got ",
              mc.pass_spp);
     }
     if (!(mc.noise_target >= 0.0) || mc.noise_target >= 1.0) {
@@ -405,9 +407,9 @@ MonteCarloSettings MakeMonteCarloSettings(int64_t spp, int64_t seed, int64_t pas
     if (seed < 0 || seed > 4294967295ll) {
         Fail(seed_flag, " must be in [0, 4294967295], got ", seed);
     }
-    if (pass_spp < 0 || pass_spp > kMaxMonteCarloSpp) {
-        Fail(pass_flag, " must be in [0, ", kMaxMonteCarloSpp, "] (0: spp/8 in [1, 64]), got ",
-             pass_spp);
+    if (pass_spp < 0) Fail(pass_flag, " must be >= 0 (0: spp/8 in [1, 64]), got ", pass_spp);
+    if (pass_spp > kMaxMonteCarloSpp) {
+        Fail(pass_flag, " must be at most ", kMaxMonteCarloSpp, " (2^32) paths, got ", pass_spp);
     }
     MonteCarloSettings mc;
     mc.spp = spp;
