@@ -102,6 +102,17 @@ double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphe
     return Seconds(start);
 }
 
+void CheckSpectralFlagsNeedWavelengths(const SpectralFlags& flags) {
+    if (!flags.wavelengths.empty()) return;
+    const SpectralFlags defaults;
+    const char* given = flags.colour != defaults.colour               ? "--colour"
+                        : flags.white != defaults.white               ? "--white"
+                        : flags.batch_seeds != defaults.batch_seeds   ? "--batch-seeds"
+                        : flags.batch_layout != defaults.batch_layout ? "--batch-layout"
+                                                                      : nullptr;
+    if (given) Fail(given, " applies to a spectral run only: give --wavelengths too");
+}
+
 SpectralBatching ParseSpectralBatching(const SpectralFlags& flags) {
     SpectralBatching batching;
     batching.seeds = ParseBatchSeeds(flags.batch_seeds);

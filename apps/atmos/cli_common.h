@@ -73,6 +73,9 @@ struct SpectralFlags {
     std::string batch_layout = "interleaved";  // harness/spectral_run.h BatchLayout
 };
 void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour = true);
+// --colour, --white, --batch-seeds and --batch-layout changed from their
+// defaults without --wavelengths (they would be ignored): one atmos::Error.
+void CheckSpectralFlagsNeedWavelengths(const SpectralFlags& flags);
 // --batch-seeds and --batch-layout as parsed values (throws on an unknown name).
 SpectralBatching ParseSpectralBatching(const SpectralFlags& flags);
 

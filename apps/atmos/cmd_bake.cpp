@@ -42,14 +42,16 @@ std::string BakeInto(const CommonOptions& common, const std::string& dir) {
     // One transaction (io/output_path.h): a failed or interrupted bake leaves
     // the previous one intact, never a mix of two.
     StagedDirectory staged(dir);
-    const fs::path into(staged.path());
-    model->Bake(into.string());
-    if (const char* shader = FindAsset(ShaderAsset(spec.name))) {
-        fs::create_directories(into / "shaders");
-        WriteText(into / ShaderAsset(spec.name), shader);
-        WriteText(into / kCommonShader, FindAsset(kCommonShader));
-        WriteEngineShaders(into.string(), spec.name, common.quiet);  // Vulkan, HLSL, Metal
-    }
+    staged.Write([&](const std::string& staging) {
+        const fs::path into(staging);
+        model->Bake(into.string());
+        if (const char* shader = FindAsset(ShaderAsset(spec.name))) {
+            fs::create_directories(into / "shaders");
+            WriteText(into / ShaderAsset(spec.name), shader);
+            WriteText(into / kCommonShader, FindAsset(kCommonShader));
+            WriteEngineShaders(into.string(), spec.name, common.quiet);  // Vulkan, HLSL, Metal
+        }
+    });
     staged.Commit();
     if (!common.quiet) {
         std::fprintf(stderr, "baked %s (precomputed in %.3f s) into %s\n", common.model.c_str(),
@@ -142,19 +144,21 @@ Command AddViewerCommand(CLI::App* root) {
         const fs::path dir(*output);
         StagedDirectory::Check(dir.string());  // before any precomputation
         StagedDirectory staged(dir.string());  // one transaction, as bake
-        const fs::path into(staged.path());
-        std::string list;
-        for (const std::string& spec : specs) {
-            CommonOptions one = *common;
-            one.model = spec;
-            const std::string name = ParseModelSpec(spec).name;
-            BakeInto(one, (into / name).string());
-            WriteViewerData(into / name, name);
-            list += (list.empty() ? "" : ", ") + JsStringLiteral(name);
-        }
-        WriteText(into / "index.html", FindAsset("viewer/index.html"));
-        WriteText(into / "viewer.js", FindAsset("viewer/viewer.js"));
-        WriteText(into / "models.js", "var atmosViewerModels = [" + list + "];\n");
+        staged.Write([&](const std::string& staging) {
+            const fs::path into(staging);
+            std::string list;
+            for (const std::string& spec : specs) {
+                CommonOptions one = *common;
+                one.model = spec;
+                const std::string name = ParseModelSpec(spec).name;
+                BakeInto(one, (into / name).string());
+                WriteViewerData(into / name, name);
+                list += (list.empty() ? "" : ", ") + JsStringLiteral(name);
+            }
+            WriteText(into / "index.html", FindAsset("viewer/index.html"));
+            WriteText(into / "viewer.js", FindAsset("viewer/viewer.js"));
+            WriteText(into / "models.js", "var atmosViewerModels = [" + list + "];\n");
+        });
         staged.Commit();
         if (!common->quiet) {
             std::fprintf(stderr, "viewer: open %s\n",

@@ -40,6 +40,7 @@ int CmdBench(BenchOptions o) {
     c.sets = o.study.sets;
     c.monte_carlo_given = o.monte_carlo.Given();
     c.monte_carlo = o.monte_carlo.Checked();
+    CheckSpectralFlagsNeedWavelengths(o.spectral);
     if (!o.spectral.wavelengths.empty()) c.wavelengths = ParseWavelengths(o.spectral.wavelengths);
     c.batching = ParseSpectralBatching(o.spectral);
     c = ResolveBenchConfig(c);

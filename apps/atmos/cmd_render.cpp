@@ -84,6 +84,7 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     CheckRenderSplit(&run.split, {ro.output, all_views, !ro.spectral.wavelengths.empty(), quantity,
                                   ro.quantity, ro.monte_carlo.spp, ro.monte_carlo.pass_spp, noise});
     CheckRenderRun(run, ro.checkpoint_every);
+    CheckSpectralFlagsNeedWavelengths(ro.spectral);
 
     ThreadLimit limit(common.threads);
     const BackendScope backend(ParseBackend(common.backend));
@@ -92,6 +93,13 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
     RequireQuantity(model->Info(), quantity);
     CheckRenderSplitModel(run.split, model->Info());
     run.monte_carlo = ro.monte_carlo.Settings(model->Info());
+    if (!model->Info().capabilities.stochastic &&
+        (ro.resume || ro.keep_checkpoint || !ro.checkpoint.empty())) {
+        Fail(
+            "--checkpoint, --resume and --keep-checkpoint apply to Monte Carlo models only; "
+            "model ",
+            model->Info().name, " is not one (`atmos list` marks them)");
+    }
     run.monte_carlo.checkpoint_seconds = ro.checkpoint_every;
     std::vector<View> views;
     if (custom) {

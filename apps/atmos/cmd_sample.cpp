@@ -33,6 +33,7 @@ struct SampleIo {
 
 int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const SampleIo& io,
               const SpectralFlags& spectral) {
+    CheckSpectralFlagsNeedWavelengths(spectral);
     if (!io.output.empty() && io.output != "-") CheckOutputFile(io.output);  // before the work
     ThreadLimit limit(common.threads);
     const BackendScope backend(ParseBackend(common.backend));

@@ -1,6 +1,7 @@
 // atmos: the on-disk render cache (see render_cache.h).
 #include "harness/render_cache.h"
 
+#include <atomic>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -148,9 +149,39 @@ bool RenderCache::Load(const RenderKey& key, Image* image, double* render_second
     }
 }
 
+namespace {
+
+// A cache that cannot be written (a full disk, a read-only directory) costs
+// speed, not the run: one warning per process, and what the failed store
+// wrote is removed (an entry is found by its JSON, written last).
+void WarnCannotStore(const std::string& directory, const std::string& why) {
+    static std::atomic<bool> warned{false};
+    if (warned.exchange(true)) return;
+    std::fprintf(stderr, "atmos: warning: render cache: cannot store in '%s' (%s); continuing\n",
+                 directory.c_str(), why.c_str());
+}
+
+}  // namespace
+
 void RenderCache::Store(const RenderKey& key, const Image& image, double render_seconds,
                         const MonteCarloReport* report, const Image* variance) const {
     if (!enabled()) return;
+    const std::string exr = ImagePath(key);
+    const std::string meta = exr.substr(0, exr.size() - 4) + ".json";
+    try {
+        StoreEntry(key, image, render_seconds, report, variance);
+    } catch (const std::exception& e) {
+        std::error_code ec;
+        for (const std::string& file :
+             {meta, exr, exr.substr(0, exr.size() - 4) + ".variance.exr", NoiseMapPath(exr)}) {
+            fs::remove(file, ec);
+        }
+        WarnCannotStore(directory_, e.what());
+    }
+}
+
+void RenderCache::StoreEntry(const RenderKey& key, const Image& image, double render_seconds,
+                             const MonteCarloReport* report, const Image* variance) const {
     fs::create_directories(directory_);
     const std::string exr = ImagePath(key);
     const std::string meta = exr.substr(0, exr.size() - 4) + ".json";
@@ -207,7 +238,6 @@ bool RenderCache::LoadPrepare(const RenderKey& key, double* seconds, int64_t* ta
 
 void RenderCache::StorePrepare(const RenderKey& key, double seconds, int64_t table_bytes) const {
     if (!enabled()) return;
-    fs::create_directories(directory_);
     RenderKey k = key;
     k.view = "(prepare)";
     nlohmann::json j;
@@ -215,7 +245,12 @@ void RenderCache::StorePrepare(const RenderKey& key, double seconds, int64_t tab
     j["prepare_seconds"] = seconds;
     j["table_bytes"] = table_bytes;
     const std::string path = PreparePath(directory_, key);
-    WriteFileAtomically(path, j.dump(1) + "\n");
+    try {
+        fs::create_directories(directory_);
+        WriteFileAtomically(path, j.dump(1) + "\n");
+    } catch (const std::exception& e) {
+        WarnCannotStore(directory_, e.what());
+    }
 }
 
 }  // namespace atmos

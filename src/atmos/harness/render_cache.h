@@ -64,6 +64,10 @@ class RenderCache {
     std::string ImagePath(const RenderKey& key) const;
 
   private:
+    // Store's work; throws on a failure (Store warns and cleans up).
+    void StoreEntry(const RenderKey& key, const Image& image, double render_seconds,
+                    const MonteCarloReport* report, const Image* variance) const;
+
     std::string directory_;
 };
 

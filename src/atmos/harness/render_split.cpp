@@ -30,7 +30,10 @@ void ParseShardSpec(const std::string& text, int64_t* index, int64_t* count) {
     const size_t slash = text.find('/');
     long long k = 0, n = 0;
     size_t used_k = 0, used_n = 0;
-    bool ok = slash != std::string::npos && slash > 0 && slash + 1 < text.size();
+    // Digits only on either side: no sign, space or other text (std::stoll
+    // would skip leading white space and take a '+').
+    bool ok = slash != std::string::npos && slash > 0 && slash + 1 < text.size() &&
+              text.find_first_not_of("0123456789/") == std::string::npos;
     try {
         if (ok) {
             k = std::stoll(text.substr(0, slash), &used_k);

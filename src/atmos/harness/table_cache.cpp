@@ -18,6 +18,7 @@
 
 #include "atmos/error.h"
 #include "base/fnv1a.h"
+#include "io/output_path.h"
 
 namespace fs = std::filesystem;
 
@@ -245,11 +246,9 @@ TablePrepareResult PrepareWithTableCache(Model* model,
         manifest["key"] = key;
         manifest["prepare_seconds"] = result.prepare_seconds;
         manifest["files"] = files;
-        {
-            std::ofstream out(tmp / kManifest);
-            out << manifest.dump(1) << "\n";
-            if (!out) Fail("cannot write ", (tmp / kManifest).string());
-        }
+        // Written last and checked through its close (a full disk would
+        // otherwise leave a truncated manifest in a stored entry).
+        WriteFileAtomically((tmp / kManifest).string(), manifest.dump(1) + "\n");
         fs::rename(tmp, entry, ec);
         if (ec) {
             fs::remove_all(tmp, ec);  // another process stored it first
@@ -257,6 +256,10 @@ TablePrepareResult PrepareWithTableCache(Model* model,
             result.stored = true;
         }
         Evict(root, settings.max_bytes, entry);
+    } catch (const fs::filesystem_error& e) {
+        fs::remove_all(tmp, ec);
+        Warn("table cache: cannot store the tables in " + root.string() + " ('" +
+             e.path1().string() + "': " + e.code().message() + ")");
     } catch (const std::exception& e) {
         fs::remove_all(tmp, ec);
         Warn(std::string("table cache: cannot store the tables in ") + root.string() + " (" +

@@ -1013,10 +1013,14 @@ Json LoadRoot(const std::string& name_or_path, const std::vector<std::string>& o
             Fail("unknown atmosphere '", name_or_path, "': not a preset (",
                  Join(AtmospherePresetNames(), ", "), ") and not a readable file");
         }
-        std::ifstream in(name_or_path, std::ios::binary);
-        if (!std::filesystem::is_regular_file(name_or_path, ec) || !in) {
-            Fail("atmosphere '", name_or_path, "': cannot read the file");
+        // Checked before opening: a FIFO with no writer would block the open.
+        if (!std::filesystem::is_regular_file(name_or_path, ec)) {
+            Fail("atmosphere '", name_or_path,
+                 "': cannot read the file (not a regular file: a directory, a FIFO or a "
+                 "device)");
         }
+        std::ifstream in(name_or_path, std::ios::binary);
+        if (!in) Fail("atmosphere '", name_or_path, "': cannot read the file");
         in.seekg(0, std::ios::end);
         const std::streamoff size = in.tellg();
         in.seekg(0, std::ios::beg);

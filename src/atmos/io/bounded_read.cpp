@@ -1,7 +1,13 @@
 // atmos: inputs read with bounds (see bounded_read.h).
 #include "io/bounded_read.h"
 
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -20,6 +26,43 @@ std::string Size(size_t bytes) {
         return std::to_string(bytes >> 20) + " MiB";
     }
     return std::to_string(bytes) + " bytes";
+}
+
+// How long a FIFO input may stay silent: ATMOS_INPUT_WAIT_SECONDS, else 10 s.
+double InputWaitSeconds() {
+    if (const char* env = std::getenv("ATMOS_INPUT_WAIT_SECONDS")) {
+        char* end = nullptr;
+        const double v = std::strtod(env, &end);
+        if (end != env && *end == '\0' && v >= 0.0 && v <= 86400.0) return v;
+    }
+    return 10.0;
+}
+
+// `path` opened for reading. A FIFO is opened without blocking (a FIFO that no
+// one writes would block the open forever) and waited for at most
+// InputWaitSeconds(); then it is read as any file.
+std::FILE* OpenInput(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0 || !S_ISFIFO(st.st_mode)) {
+        return std::fopen(path.c_str(), "rb");
+    }
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return nullptr;
+    const double wait = InputWaitSeconds();
+    pollfd p{fd, POLLIN, 0};
+    int ready = 0;
+    do {
+        ready = ::poll(&p, 1, static_cast<int>(wait * 1000.0));
+    } while (ready < 0 && errno == EINTR);
+    if (ready <= 0) {
+        ::close(fd);
+        Fail("cannot read '", path, "': it is a FIFO and nothing was written to it within ", wait,
+             " s");
+    }
+    ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+    std::FILE* file = ::fdopen(fd, "rb");
+    if (!file) ::close(fd);
+    return file;
 }
 
 }  // namespace
@@ -70,10 +113,20 @@ std::string ReadFileBounded(const std::string& path, size_t max_bytes, size_t ma
     if (std::filesystem::is_directory(path, ec))
         Fail("cannot read '", path, "': it is a directory");
     errno = 0;
-    std::unique_ptr<std::FILE, decltype(&std::fclose)> file(std::fopen(path.c_str(), "rb"),
-                                                            &std::fclose);
+    std::unique_ptr<std::FILE, decltype(&std::fclose)> file(OpenInput(path), &std::fclose);
     if (!file) Fail("cannot open '", path, "' for reading: ", std::strerror(errno));
     return ReadBounded(file.get(), "'" + path + "'", max_bytes, max_line);
+}
+
+void RequireRegularInput(const std::string& path, const std::string& what) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return;
+    Fail("cannot read ", what, " '", path, "': it is not a regular file (",
+         S_ISDIR(st.st_mode)    ? "a directory"
+         : S_ISFIFO(st.st_mode) ? "a FIFO"
+         : S_ISCHR(st.st_mode)  ? "a device"
+                                : "a socket or a block device",
+         ")");
 }
 
 void CheckImageDimensions(int64_t width, int64_t height, const std::string& what) {

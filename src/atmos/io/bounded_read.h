@@ -27,8 +27,16 @@ constexpr int kMaxImageSide = 65535;
 // `max_bytes`, and when `max_line` > 0 no line longer than `max_line` bytes.
 std::string ReadBounded(std::FILE* file, const std::string& what, size_t max_bytes,
                         size_t max_line = 0);
-// The same for the file `path` (a directory is refused).
+// The same for the file `path` (a directory is refused). A FIFO is opened
+// without blocking and must deliver within ATMOS_INPUT_WAIT_SECONDS (10 s by
+// default), else one atmos::Error: a FIFO that no one writes never hangs.
 std::string ReadFileBounded(const std::string& path, size_t max_bytes, size_t max_line = 0);
+
+// One atmos::Error when `path` exists and is not a regular file (a FIFO, a
+// device, a socket), for readers that open by name and would block on a FIFO
+// no one writes or read a device without end (EXR, PNG, neural weights);
+// `what` names the input. A missing path passes (the reader names it).
+void RequireRegularInput(const std::string& path, const std::string& what);
 
 // One atmos::Error unless width x height is an image atmos reads (the limits
 // above), before anything is allocated for it; `what` names the file.

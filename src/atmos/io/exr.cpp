@@ -6,6 +6,7 @@
 #include <ImfOutputFile.h>
 #include <ImfRgba.h>
 #include <ImfRgbaFile.h>
+#include <ImfStdIO.h>
 #include <ImfStringAttribute.h>
 
 #include <cstdint>
@@ -123,6 +124,22 @@ Image ReadExrImpl(const std::string& path) {
     return image;
 }
 
+// The file is built in memory and written by WriteFileBytes, whose every
+// write and close is checked: OpenEXR's OutputFile writes its last bytes (the
+// line offsets) and flushes from its destructor, where a failure (a full
+// disk) is swallowed and a truncated file would pass as written.
+void WriteExrThroughMemory(const std::string& path, const Imf::Header& header,
+                           const Imf::FrameBuffer& frame, int rows) {
+    Imf::StdOSStream stream;
+    {
+        Imf::OutputFile file(stream, header);
+        file.setFrameBuffer(frame);
+        file.writePixels(rows);
+    }
+    const std::string bytes = stream.str();
+    WriteFileBytes(path, std::vector<std::uint8_t>(bytes.begin(), bytes.end()));
+}
+
 }  // namespace
 
 void WriteExr(const Image& image, const std::string& path) {
@@ -142,9 +159,7 @@ void WriteExr(const Image& image, const std::string& path) {
         frame.insert("G", Imf::Slice::Make(Imf::FLOAT, base + 1, window, x_stride, y_stride));
         frame.insert("B", Imf::Slice::Make(Imf::FLOAT, base + 2, window, x_stride, y_stride));
 
-        Imf::OutputFile file(path.c_str(), header);
-        file.setFrameBuffer(frame);
-        file.writePixels(image.height());
+        WriteExrThroughMemory(path, header, frame, image.height());
     } catch (const Error&) {
         throw;
     } catch (const std::exception& e) {
@@ -171,9 +186,7 @@ void WriteMultiChannelExr(const std::string& path, int width, int height,
             frame.insert(names[c], Imf::Slice::Make(Imf::FLOAT, values.data() + c, window, x_stride,
                                                     y_stride));
         }
-        Imf::OutputFile file(path.c_str(), header);
-        file.setFrameBuffer(frame);
-        file.writePixels(height);
+        WriteExrThroughMemory(path, header, frame, height);
     } catch (const Error&) {
         throw;
     } catch (const std::exception& e) {
@@ -182,6 +195,7 @@ void WriteMultiChannelExr(const std::string& path, int width, int height,
 }
 
 Image ReadExr(const std::string& path) {
+    RequireRegularInput(path, "EXR");  // OpenEXR opens by name: a FIFO would block it
     try {
         return ReadExrImpl(path);
     } catch (const Error&) {

@@ -389,6 +389,14 @@ StagedDirectory::~StagedDirectory() {
     std::filesystem::remove_all(staging_, ignored);
 }
 
+void StagedDirectory::Write(const std::function<void(const std::string& staging)>& write) const {
+    try {
+        write(staging_);
+    } catch (const Error& e) {
+        throw RenameInMessage(e, staging_, final_);
+    }
+}
+
 void StagedDirectory::Commit() {
     std::error_code ec;
     if (!std::filesystem::exists(final_, ec)) {

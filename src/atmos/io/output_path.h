@@ -93,6 +93,9 @@ class StagedDirectory : private NonCopyable {
     explicit StagedDirectory(const std::string& final_path);
     ~StagedDirectory();
     const std::string& path() const { return staging_; }
+    // Runs `write` on path(); an atmos::Error it throws names the final
+    // directory in place of the staging one (which is removed).
+    void Write(const std::function<void(const std::string& staging)>& write) const;
     void Commit();
     // Before the work: CheckOutputDirectory, and an existing `path` holds only
     // what atmos writes (tables, JSON, shaders, viewer pages; it is replaced

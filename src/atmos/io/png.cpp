@@ -148,14 +148,23 @@ void WritePngBytes(const std::vector<std::uint8_t>& bytes, int width, int height
     png.width = static_cast<png_uint_32>(width);
     png.height = static_cast<png_uint_32>(height);
     png.format = PNG_FORMAT_RGB;  // 8-bit sRGB-encoded RGB
-    errno = 0;
-    const int ok = png_image_write_to_file(&png, path.c_str(), 0, bytes.data(), 0, nullptr);
+    // Encoded in memory and written by WriteFileBytes (each write and the
+    // close checked): a failure names its reason (a full disk), not libpng's
+    // "Write Error".
+    png_alloc_size_t size = 0;
+    int ok = png_image_write_get_memory_size(png, size, 0, bytes.data(), 0, nullptr);
+    std::vector<std::uint8_t> encoded(ok != 0 ? size : 0);
+    if (ok != 0)
+        ok = png_image_write_to_memory(&png, encoded.data(), &size, 0, bytes.data(), 0, nullptr);
     const std::string message = png.message;
     png_image_free(&png);
     if (ok == 0) Fail("cannot write PNG '", path, "': ", message);
+    encoded.resize(size);
+    WriteFileBytes(path, encoded);
 }
 
 Image ReadPng(const std::string& path) {
+    RequireRegularInput(path, "PNG");  // a FIFO no one writes would block the open
     errno = 0;
     FilePtr file(std::fopen(path.c_str(), "rb"));
     if (!file) Fail("cannot open '", path, "' for reading: ", std::strerror(errno));

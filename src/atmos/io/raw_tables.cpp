@@ -7,6 +7,7 @@
 #include <ostream>
 
 #include "atmos/error.h"
+#include "io/image_formats.h"
 #include "io/output_path.h"
 
 namespace atmos {
@@ -59,11 +60,7 @@ size_t AlignUp(size_t n) { return (n + kAlign - 1) / kAlign * kAlign; }
 // never leaves a truncated table file.
 void WriteFile(const std::string& path, const std::vector<unsigned char>& bytes) {
     WriteThroughTemporary(path, [&](const std::string& temporary) {
-        std::ofstream out(temporary, std::ios::binary);
-        out.write(reinterpret_cast<const char*>(bytes.data()),
-                  static_cast<std::streamsize>(bytes.size()));
-        out.close();
-        if (!out) Fail("cannot write '", path, "'");
+        detail::WriteFileBytes(temporary, bytes);  // each write and the close checked
     });
 }
 

@@ -9,6 +9,7 @@
 
 #include "atmos/embedded_presets.h"
 #include "atmos/error.h"
+#include "io/bounded_read.h"
 
 namespace atmos {
 
@@ -244,6 +245,7 @@ std::string NeuralWeightsToJson(const NeuralWeights& w) {
 }
 
 NeuralWeights LoadNeuralWeights(const std::string& path) {
+    RequireRegularInput(path, "neural weights");  // a FIFO no one writes would block the open
     std::ifstream in(path, std::ios::binary);
     if (!in) Fail("neural weights: cannot open '", path, "'");
     std::stringstream ss;

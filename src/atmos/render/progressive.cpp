@@ -31,6 +31,10 @@ namespace atmos {
 
 namespace {
 
+// The most paths per pixel (and per pass): 2^32, far beyond any render, and
+// far from where the pass arithmetic overflows.
+constexpr int64_t kMaxMonteCarloSpp = int64_t{1} << 32;
+
 void RequireMonteCarlo(const Model& model) {
     if (!model.Info().capabilities.stochastic) {
         Fail("model ", model.Info().name,
@@ -39,8 +43,17 @@ void RequireMonteCarlo(const Model& model) {
 }
 
 void CheckSettings(const MonteCarloSettings& mc) {
+    // Bounded so that the pass arithmetic cannot overflow (a --spp near 2^63
+    // rendered nothing in 0 s and exited 0).
     if (mc.spp < 1) Fail("Monte Carlo render: spp must be at least 1, got ", mc.spp);
+    if (mc.spp > kMaxMonteCarloSpp) {
+        Fail("Monte Carlo render: spp must be at most ", kMaxMonteCarloSpp, ", got ", mc.spp);
+    }
     if (mc.pass_spp < 0) Fail("Monte Carlo render: pass spp must be >= 0, got ", mc.pass_spp);
+    if (mc.pass_spp > kMaxMonteCarloSpp) {
+        Fail("Monte Carlo render: pass spp must be at most ", kMaxMonteCarloSpp, ", got ",
+             mc.pass_spp);
+    }
     if (!(mc.noise_target >= 0.0) || mc.noise_target >= 1.0) {
         Fail("Monte Carlo render: the noise target must be in (0, 1) (0: off), got ",
              mc.noise_target);
@@ -210,10 +223,13 @@ void CommitCheckpoint(const std::string& path, const std::string& bytes) {
         ::unlink(tmp.c_str());
         throw;
     }
-    if (::fsync(fd) != 0 || ::close(fd) != 0) {
-        const int err = errno;
+    const bool synced = ::fsync(fd) == 0;
+    int sync_error = errno;
+    const bool closed = ::close(fd) == 0;  // closed whether or not the fsync failed
+    if (synced && !closed) sync_error = errno;
+    if (!synced || !closed) {
         ::unlink(tmp.c_str());
-        Fail("cannot write checkpoint '", path, "': ", std::strerror(err));
+        Fail("cannot write checkpoint '", path, "': ", std::strerror(sync_error));
     }
     if (std::rename(tmp.c_str(), path.c_str()) != 0) {
         const int err = errno;
@@ -385,10 +401,16 @@ MonteCarloSettings MakeMonteCarloSettings(int64_t spp, int64_t seed, int64_t pas
                                           const char* spp_flag, const char* seed_flag,
                                           const char* pass_flag) {
     if (spp < 1) Fail(spp_flag, " must be at least 1, got ", spp);
+    if (spp > kMaxMonteCarloSpp) {
+        Fail(spp_flag, " must be at most ", kMaxMonteCarloSpp, " (2^32) paths, got ", spp);
+    }
     if (seed < 0 || seed > 4294967295ll) {
         Fail(seed_flag, " must be in [0, 4294967295], got ", seed);
     }
     if (pass_spp < 0) Fail(pass_flag, " must be >= 0 (0: spp/8 in [1, 64]), got ", pass_spp);
+    if (pass_spp > kMaxMonteCarloSpp) {
+        Fail(pass_flag, " must be at most ", kMaxMonteCarloSpp, " (2^32) paths, got ", pass_spp);
+    }
     MonteCarloSettings mc;
     mc.spp = spp;
     mc.seed = static_cast<uint64_t>(seed);
