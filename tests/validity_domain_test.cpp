@@ -109,6 +109,40 @@ TEST(ValidityDomain, GiantPlanetRightOrWarned) { ExpectRightOrWarned(1e9, 2e9); 
 
 TEST(ValidityDomain, DoubleShellRightOrWarned) { ExpectRightOrWarned(6360e3, 12720e3); }
 
+// The thick presets (optical depth 8.4 and 67): every deterministic model
+// that precomputes multiple scattering from the atmosphere says it is off
+// there, by its declared domain, a warning from Prepare() or a refusal
+// (atmosphere-plus answered Titan's zenith 12x too bright in blue without a
+// word). The fitted Earth skies (preetham, hosek-wilkie) do not read the
+// atmosphere at all and are not asked.
+TEST(ValidityDomain, ThickPresetsWarnInEveryMultipleScatteringModel) {
+    for (const char* preset : {"titan", "venus"}) {
+        const AtmosphereParameters atmosphere = LoadAtmosphere(preset);
+        int checked = 0;
+        for (const ModelInfo& info : ListModels()) {
+            if (!info.capabilities.multiple_scattering || !info.capabilities.precomputed ||
+                info.capabilities.stochastic) {
+                continue;
+            }
+            ++checked;
+            if (!ValidityDomainViolations(info, atmosphere).empty()) continue;
+            std::unique_ptr<Model> model = CreateModel(info.name);
+            ::testing::internal::CaptureStderr();
+            bool refused = false;
+            try {
+                model->Prepare(atmosphere);
+            } catch (const Error&) {
+                refused = true;
+            }
+            const std::string err = ::testing::internal::GetCapturedStderr();
+            EXPECT_TRUE(refused || err.find("warning") != std::string::npos)
+                << info.name << " on " << preset << ": no warning, no refusal\n"
+                << err;
+        }
+        EXPECT_GE(checked, 3) << preset;  // bruneton, hillaire, atmosphere-plus at least
+    }
+}
+
 // The Earth presets the figures and tables use are inside every domain (no
 // warning where the models are measured right).
 TEST(ValidityDomain, EarthPresetsAreInsideEveryDomain) {

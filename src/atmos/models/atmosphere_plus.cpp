@@ -117,6 +117,14 @@ ModelInfo AtmospherePlusModel::StaticInfo() {
         "its tables' altitude mapping spreads their texels over the whole shell, few in the "
         "air near the ground (zenith transmittance -4.8 % at 44 heights, 0.019 (blue) on the 2x "
         "shell)";
+    // Measured against the reference in dense air (docs/models/atmosphere-plus.md
+    // "Validity domain"): Earth's Rayleigh times k, the worst of two ground
+    // queries -4 % at k = 1, -12 % at k = 2 (blue optical depth ~0.54), -24 % at
+    // k = 4, 8x too dark at 16; on `titan` its blue zenith is 12x too bright.
+    info.domain.max_optical_depth = 0.6;
+    info.domain.optical_depth_reason =
+        "the sky is wrong in dense air: radiance -12 % at optical depth 0.54, -24 % at 1.07, "
+        "8x too dark at 4.2 (against the reference)";
     return info;
 }
 
