@@ -40,25 +40,28 @@ float atmos_HenyeyGreensteinPhase(float g, float nu) {
     float denom = 1.0 + g * g - 2.0 * g * nu;
     return (1.0 - g * g) / (4.0 * ATMOS_PI * denom * sqrt(denom));
 }
-// MiePhase (phase.h): CornetteShanksPhase with g = ATMOS_MIE_PHASE_G, or, when
-// the constants define ATMOS_MIE_PHASE_WEIGHT2 (an atmosphere with a second
-// lobe), (1 - w) CS(ATMOS_MIE_PHASE_G) + w CS(ATMOS_MIE_PHASE_G2). When they
-// define ATMOS_MIE_PHASE_KIND (atmosphere.h MiePhaseKind): 1 the same lobes of
-// Henyey-Greenstein, 2 isotropic, 3 tabulated (TabulatedPhase: the constants'
-// atmos_MiePhaseTableMu and atmos_MiePhaseTableValue, linear in nu between nodes).
-float atmos_MiePhase(float nu) {
-#ifdef ATMOS_MIE_PHASE_KIND
-#if ATMOS_MIE_PHASE_KIND == 1
-#ifdef ATMOS_MIE_PHASE_WEIGHT2
-    float w = ATMOS_MIE_PHASE_WEIGHT2;
-    return (1.0 - w) * atmos_HenyeyGreensteinPhase(ATMOS_MIE_PHASE_G, nu) +
-           w * atmos_HenyeyGreensteinPhase(ATMOS_MIE_PHASE_G2, nu);
-#else
-    return atmos_HenyeyGreensteinPhase(ATMOS_MIE_PHASE_G, nu);
+// The Mie phase's kind (atmosphere.h MiePhaseKind): the constants define it
+// for every kind but Cornette-Shanks (0).
+#ifndef ATMOS_MIE_PHASE_KIND
+#define ATMOS_MIE_PHASE_KIND 0
 #endif
-#elif ATMOS_MIE_PHASE_KIND == 2
-    return 1.0 / (4.0 * ATMOS_PI);
+// One lobe of the Mie phase: Henyey-Greenstein (kind 1) or Cornette-Shanks.
+float atmos_MieLobe(float g, float nu) {
+#if ATMOS_MIE_PHASE_KIND == 1
+    return atmos_HenyeyGreensteinPhase(g, nu);
 #else
+    return atmos_CornetteShanksPhase(g, nu);
+#endif
+}
+// MiePhase (phase.h): 2 isotropic; 3 tabulated (TabulatedPhase: the constants'
+// atmos_MiePhaseTableMu and atmos_MiePhaseTableValue, linear in nu between
+// nodes); else the lobe with g = ATMOS_MIE_PHASE_G, or, when the constants
+// define ATMOS_MIE_PHASE_WEIGHT2 (a second lobe), (1 - w) lobe(ATMOS_MIE_PHASE_G)
+// + w lobe(ATMOS_MIE_PHASE_G2).
+float atmos_MiePhase(float nu) {
+#if ATMOS_MIE_PHASE_KIND == 2
+    return 1.0 / (4.0 * ATMOS_PI);
+#elif ATMOS_MIE_PHASE_KIND == 3
     float x = clamp(nu, -1.0, 1.0);
     for (int i = 0; i < ATMOS_MIE_PHASE_TABLE_COUNT - 1; ++i) {
         float a = atmos_MiePhaseTableMu[i + 1];
@@ -69,15 +72,11 @@ float atmos_MiePhase(float nu) {
         }
     }
     return atmos_MiePhaseTableValue[ATMOS_MIE_PHASE_TABLE_COUNT - 1];
-#endif
-#else
-#ifdef ATMOS_MIE_PHASE_WEIGHT2
+#elif defined(ATMOS_MIE_PHASE_WEIGHT2)
     float w = ATMOS_MIE_PHASE_WEIGHT2;
-    return (1.0 - w) * atmos_CornetteShanksPhase(ATMOS_MIE_PHASE_G, nu) +
-           w * atmos_CornetteShanksPhase(ATMOS_MIE_PHASE_G2, nu);
+    return (1.0 - w) * atmos_MieLobe(ATMOS_MIE_PHASE_G, nu) + w * atmos_MieLobe(ATMOS_MIE_PHASE_G2, nu);
 #else
-    return atmos_CornetteShanksPhase(ATMOS_MIE_PHASE_G, nu);
-#endif
+    return atmos_MieLobe(ATMOS_MIE_PHASE_G, nu);
 #endif
 }
 // DistanceToTopAtmosphereBoundary (geometry.h; Bruneton's 2017 implementation notes "Distance to the top
