@@ -105,11 +105,12 @@ double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphe
 void CheckSpectralFlagsNeedWavelengths(const SpectralFlags& flags) {
     if (!flags.wavelengths.empty()) return;
     const SpectralFlags defaults;
-    const char* given = flags.colour != defaults.colour               ? "--colour"
-                        : flags.white != defaults.white               ? "--white"
-                        : flags.batch_seeds != defaults.batch_seeds   ? "--batch-seeds"
-                        : flags.batch_layout != defaults.batch_layout ? "--batch-layout"
-                                                                      : nullptr;
+    const char* given = flags.colour != defaults.colour                     ? "--colour"
+                        : flags.white != defaults.white                     ? "--white"
+                        : flags.batch_seeds != defaults.batch_seeds         ? "--batch-seeds"
+                        : flags.batch_layout != defaults.batch_layout       ? "--batch-layout"
+                        : flags.channel_batches != defaults.channel_batches ? "--channel-batches"
+                                                                            : nullptr;
     if (given) Fail(given, " applies to a spectral run only: give --wavelengths too");
 }
 
@@ -117,6 +118,7 @@ SpectralBatching ParseSpectralBatching(const SpectralFlags& flags) {
     SpectralBatching batching;
     batching.seeds = ParseBatchSeeds(flags.batch_seeds);
     batching.layout = ParseBatchLayout(flags.batch_layout);
+    batching.wide = ParseChannelBatches(flags.channel_batches);
     return batching;
 }
 
@@ -136,6 +138,11 @@ void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour) {
            "with --wavelengths: interleaved (batch b holds wavelengths b, b+S, b+2S "
            "with S = ceil(N/3): hero-wavelength companions spread over the range; with "
            "distinct seeds the least colour noise at equal time) or consecutive (3b..3b+2)")
+        ->capture_default_str();
+    cmd->add_option("--channel-batches", flags->channel_batches,
+                    "with --wavelengths: wide (a model with wide channel batches is prepared "
+                    "once for up to 16 batches of three and shares each ray's geometry across "
+                    "their channels: the same values, faster) or three (a model per batch)")
         ->capture_default_str();
     if (!colour) return;
     cmd->add_option("--colour", flags->colour,

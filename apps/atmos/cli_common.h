@@ -71,6 +71,7 @@ struct SpectralFlags {
     std::string white = "d65";
     std::string batch_seeds = "distinct";      // harness/spectral_run.h BatchSeeds
     std::string batch_layout = "interleaved";  // harness/spectral_run.h BatchLayout
+    std::string channel_batches = "wide";      // SpectralBatching::wide: wide or three
 };
 void AddSpectralFlags(CLI::App* cmd, SpectralFlags* flags, bool colour = true);
 // --colour, --white, --batch-seeds and --batch-layout changed from their

@@ -42,7 +42,9 @@ int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const S
         ParseWavelengths(spectral.wavelengths);  // fail before reading stdin
         const MonteCarloSettings mc = flags.Settings(CreateModel(GivenModel(common))->Info());
         const bool npy = !io.output.empty() && io.output != "-" && IsNpyPath(io.output);
-        const SpectralBatching batching = ParseSpectralBatching(spectral);
+        SpectralBatching batching = ParseSpectralBatching(spectral);
+        // Baked tables are loaded per batch (PrepareModel): no wide path.
+        if (!common.load.empty()) batching.wide = false;
         std::vector<SampleQuery> queries = ReadQueries(io.input);
         for (SampleQuery& q : queries) q.ground = io.ground ? 1 : 0;
         return SampleSpectralCsv(common, mc, spectral.wavelengths, queries, batching, io.output,

@@ -45,6 +45,13 @@ struct ModelCapabilities {
     bool spectral = true;
     // `atmos fit` trains its weights against a reference model.
     bool trainable = false;
+    // Wide channel batches (docs/performance.md "Wide channel batches"): one
+    // model takes up to kMaxWideChannels channels (PrepareWide, RenderWide,
+    // SampleWide), sharing each ray's geometry and table coordinates across
+    // them; a spectral run then prepares one model for all its batches of
+    // three instead of one per batch. Channel 3b + c of a wide run equals
+    // channel c of batch b's three-channel run, bit for bit.
+    bool wide_channels = false;
     // A baseline that models nothing (`empty`): compare leaves it out of the
     // Pareto front and of the verdict per regime.
     bool baseline = false;
@@ -177,6 +184,10 @@ struct MonteCarloPass {
 class Progress;
 struct SpectralAtmosphere;  // atmos/spectral.h
 
+// The most channels one wide model takes (ModelCapabilities::wide_channels):
+// 16 batches of three; a spectral run with more wavelengths uses several.
+constexpr int kMaxWideChannels = 48;
+
 struct RenderRequest {
     View view;
     int width = 480;
@@ -225,6 +236,17 @@ class Model {
     // atmosphere's solar irradiance) or transmittance into `out` (resized).
     virtual void Render(const RenderRequest& request, Image* out) const = 0;
     virtual std::vector<SampleAnswer> Sample(const std::vector<SampleQuery>& queries) const = 0;
+
+    // Wide channel batches (ModelCapabilities::wide_channels; others throw
+    // atmos::Error). PrepareWide prepares for 3 x batches.size() channels at
+    // once (at most kMaxWideChannels): batch b's atmosphere gives channels 3b ..
+    // 3b + 2; the batches differ only in their per-channel coefficients
+    // (AtWavelengths), else it throws naming the field. RenderWide renders as
+    // Render, every channel (values[pixel * channels + c], resized);
+    // SampleWide answers as Sample's radiance ([query * channels + c]).
+    virtual void PrepareWide(const std::vector<AtmosphereParameters>& batches);
+    virtual void RenderWide(const RenderRequest& request, std::vector<float>* values) const;
+    virtual std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const;
 
     // Monte Carlo models (ModelCapabilities::stochastic) provide one pass; the
     // progressive driver (src/atmos/render/progressive.h) runs the passes and

@@ -185,6 +185,7 @@ void RenderSpectralViews(const RenderRun& run, const ModelSpec& spec,
     SpectralBatching batching;
     batching.seeds = ParseBatchSeeds(flags.batch_seeds);
     batching.layout = ParseBatchLayout(flags.batch_layout);
+    batching.wide = ParseChannelBatches(flags.channel_batches);
     const SpectralAtmosphere atmosphere = LoadSpectralAtmosphere(flags.atmosphere, flags.sets);
     const bool all_views = run.all_views;
     const int width = run.width, height = run.height;

@@ -67,7 +67,8 @@ struct SpectralRenderFlags {
     std::string batch_layout;
     std::string atmosphere;
     std::vector<std::string> sets;
-    bool load = false;  // --load given (refused)
+    bool load = false;                     // --load given (refused)
+    std::string channel_batches = "wide";  // --channel-batches
 };
 
 // --wavelengths: the views rendered at each wavelength (harness/spectral_run.h);

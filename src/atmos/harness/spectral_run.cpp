@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "atmos/error.h"
+#include "base/parallel.h"
 #include "io/image_formats.h"
 #include "io/output_path.h"
 #include "render/progressive.h"
@@ -47,7 +48,45 @@ void ForEachPreparedBatch(const ModelSpec& spec, const SpectralAtmosphere& atmos
     }
 }
 
+// The wide path (SpectralBatching::wide): calls each(indices, stored, model,
+// batches) for groups of at most kMaxWideChannels / 3 consecutive batches of
+// SpectralBatches, with one model of `spec` prepared for all of them
+// (PrepareWide): `indices[g]` and `stored[g]` are the g-th batch's, `batches[g]`
+// its atmosphere; the model's channel 3g + c is that batch's channel c.
+template <typename F>
+void ForEachWideGroup(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
+                      const std::vector<double>& nm, BatchLayout layout, F each) {
+    const std::vector<std::array<size_t, 3>> batches = SpectralBatches(nm.size(), layout);
+    const size_t per_group = static_cast<size_t>(kMaxWideChannels / 3);
+    for (size_t first = 0; first < batches.size(); first += per_group) {
+        const size_t count = std::min(per_group, batches.size() - first);
+        std::vector<std::array<size_t, 3>> indices(batches.begin() + first,
+                                                   batches.begin() + first + count);
+        std::vector<size_t> stored;
+        std::vector<AtmosphereParameters> group;
+        for (const std::array<size_t, 3>& b : indices) {
+            stored.push_back(StoredChannels(b));
+            group.push_back(atmosphere.AtWavelengths(nm[b[0]], nm[b[1]], nm[b[2]]));
+        }
+        std::unique_ptr<Model> model = CreateModel(spec);
+        RequireSpectralModel(model->Info());
+        model->PrepareWide(group);
+        each(indices, stored, *model, group);
+    }
+}
+
 }  // namespace
+
+bool ParseChannelBatches(const std::string& text) {
+    if (text == "wide") return true;
+    if (text == "three") return false;
+    Fail("--channel-batches '", text, "': expected wide or three");
+}
+
+bool UsesWideBatches(const ModelInfo& info, SpectralBatching batching) {
+    return batching.wide && info.capabilities.wide_channels && !info.capabilities.stochastic &&
+           CurrentBackend() == Backend::kCpu;
+}
 
 BatchSeeds ParseBatchSeeds(const std::string& text) {
     if (text == "same") return BatchSeeds::kSame;
@@ -114,6 +153,36 @@ std::vector<SpectralImage> RenderSpectralRequests(
     }
     if (render_seconds) render_seconds->assign(requests.size(), 0.0);
     if (reports) reports->assign(requests.size(), MonteCarloReport());
+    if (UsesWideBatches(CreateModel(spec)->Info(), batching)) {
+        ForEachWideGroup(
+            spec, atmosphere, nm, batching.layout,
+            [&](const std::vector<std::array<size_t, 3>>& indices,
+                const std::vector<size_t>& stored, Model& model,
+                const std::vector<AtmosphereParameters>&) {
+                const size_t channels = 3 * indices.size();
+                for (size_t v = 0; v < requests.size(); ++v) {
+                    std::vector<float> values;
+                    const auto start = std::chrono::steady_clock::now();
+                    model.RenderWide(requests[v], &values);
+                    if (render_seconds) {
+                        (*render_seconds)[v] +=
+                            std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+                                .count();
+                    }
+                    const size_t pixels =
+                        static_cast<size_t>(requests[v].width) * requests[v].height;
+                    for (size_t p = 0; p < pixels; ++p) {
+                        for (size_t g = 0; g < indices.size(); ++g) {
+                            for (size_t c = 0; c < stored[g]; ++c) {
+                                out[v].values[p * n + indices[g][c]] =
+                                    values[p * channels + 3 * g + c];
+                            }
+                        }
+                    }
+                }
+            });
+        return out;
+    }
     ForEachPreparedBatch(
         spec, atmosphere, nm, batching.layout, prepare,
         [&](size_t b, const std::array<size_t, 3>& indices, size_t stored, Model& model,
@@ -176,6 +245,26 @@ std::vector<double> SampleSpectral(const ModelSpec& spec, const SpectralAtmosphe
                                    const PrepareFunction& prepare, SpectralBatching batching) {
     const size_t n = nm.size();
     std::vector<double> out(queries.size() * n, 0.0);
+    if (UsesWideBatches(CreateModel(spec)->Info(), batching)) {
+        ForEachWideGroup(spec, atmosphere, nm, batching.layout,
+                         [&](const std::vector<std::array<size_t, 3>>& indices,
+                             const std::vector<size_t>& stored, Model& model,
+                             const std::vector<AtmosphereParameters>& batches) {
+                             const size_t channels = 3 * indices.size();
+                             const std::vector<float> values = model.SampleWide(queries);
+                             for (size_t q = 0; q < queries.size(); ++q) {
+                                 for (size_t g = 0; g < indices.size(); ++g) {
+                                     for (size_t c = 0; c < stored[g]; ++c) {
+                                         const int ci = static_cast<int>(c);
+                                         out[q * n + indices[g][c]] =
+                                             static_cast<double>(values[q * channels + 3 * g + c]) *
+                                             batches[g].solar_irradiance[ci];
+                                     }
+                                 }
+                             }
+                         });
+        return out;
+    }
     ForEachPreparedBatch(
         spec, atmosphere, nm, batching.layout, prepare,
         [&](size_t b, const std::array<size_t, 3>& indices, size_t stored, Model& model,

@@ -54,11 +54,25 @@ BatchLayout ParseBatchLayout(const std::string& text);  // "consecutive" or "int
 // layout and seeds", scripts/spectral_noise.py). kPerWavelength: consecutive
 // batches with one seed, the least noise in each wavelength's own value (what
 // validate scores).
+//
+// `wide`: a model with wide channel batches (ModelCapabilities::wide_channels;
+// deterministic, on the CPU backend) is prepared once for up to
+// kMaxWideChannels / 3 batches and evaluates all their channels per ray
+// (Model::PrepareWide; the `prepare` function is then not called): the same
+// values bit for bit, the geometry computed once per ray instead of once per
+// batch. false: one model per batch of three, as every other model.
 struct SpectralBatching {
     BatchSeeds seeds = BatchSeeds::kDistinct;
     BatchLayout layout = BatchLayout::kInterleaved;
+    bool wide = true;
 };
-constexpr SpectralBatching kPerWavelengthBatching{BatchSeeds::kSame, BatchLayout::kConsecutive};
+// "wide" or "three" (--channel-batches) as SpectralBatching::wide.
+bool ParseChannelBatches(const std::string& text);
+// Whether a spectral run of `info`'s model takes the wide path now
+// (`batching.wide`, the capability, not Monte Carlo, the CPU backend).
+bool UsesWideBatches(const ModelInfo& info, SpectralBatching batching);
+constexpr SpectralBatching kPerWavelengthBatching{BatchSeeds::kSame, BatchLayout::kConsecutive,
+                                                  true};
 
 // The wavelength indices of each batch, ceil(N/3) batches of three; a batch short
 // of three repeats its last index (its extra channels are computed, not stored).

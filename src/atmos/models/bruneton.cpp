@@ -12,7 +12,9 @@
 #include "io/raw_tables.h"
 #include "io/table_io.h"
 #include "io/text_files.h"
+#include "models/bruneton_wide.h"
 #include "models/option_json.h"
+#include "render/wide.h"
 
 namespace atmos {
 
@@ -35,6 +37,7 @@ ModelInfo BrunetonModel::StaticInfo() {
         "4D scattering tables (packed 3D), transmittance and irradiance tables, N orders";
     info.capabilities.multiple_scattering = true;
     info.capabilities.precomputed = true;
+    info.capabilities.wide_channels = true;  // separate Mie storage (the constructor)
     info.options = OptionRows().Specs();
     info.capabilities.shader = "bruneton";
     info.capabilities.validity_notes = {
@@ -118,7 +121,73 @@ const OptionTable<BrunetonConfig>& BrunetonModel::OptionRows() {
 }
 
 BrunetonModel::BrunetonModel(const BrunetonConfig& options)
-    : info_(StaticInfo()), config_(options), atm_(EarthAtmosphere()) {}
+    : info_(StaticInfo()), config_(options), atm_(EarthAtmosphere()) {
+    // The wide evaluator reads separate Mie tables (combined storage
+    // extrapolates green and blue from red: no wide form).
+    info_.capabilities.wide_channels = !config_.combined_mie;
+}
+
+namespace {
+
+// Copies the three channels of `batch` into channels 3b .. 3b + 2 of `wide`
+// (sized as `batch` with `channels` channels on the first batch).
+void GatherChannels(const Table& batch, int b, int channels, Table* wide) {
+    if (b == 0) wide->Resize(batch.width(), batch.height(), batch.depth(), channels);
+    const size_t texels = static_cast<size_t>(batch.width()) * batch.height() * batch.depth();
+    const size_t n = static_cast<size_t>(channels);
+    const float* src = batch.data();
+    float* dst = wide->data() + 3 * static_cast<size_t>(b);
+    for (size_t i = 0; i < texels; ++i) {
+        for (size_t c = 0; c < 3; ++c) dst[i * n + c] = src[i * 3 + c];
+    }
+}
+
+}  // namespace
+
+void BrunetonModel::PrepareWide(const std::vector<AtmosphereParameters>& batches) {
+    if (!info_.capabilities.wide_channels) Model::PrepareWide(batches);
+    const WideCoefficients wide = MakeWideCoefficients(batches);
+    for (const AtmosphereParameters& a : batches) WarnOutsideValidityDomain(Info(), a);
+    // The tables of each batch, as Prepare() computes them, side by side.
+    BrunetonTables wide_tables;
+    for (size_t b = 0; b < batches.size(); ++b) {
+        BrunetonTables t;
+        PrecomputeBruneton(batches[b], config_, &t);
+        const int bi = static_cast<int>(b);
+        GatherChannels(t.transmittance, bi, wide.channels, &wide_tables.transmittance);
+        GatherChannels(t.irradiance, bi, wide.channels, &wide_tables.irradiance);
+        GatherChannels(t.scattering, bi, wide.channels, &wide_tables.scattering);
+        GatherChannels(t.single_mie, bi, wide.channels, &wide_tables.single_mie);
+    }
+    wide_tables_ = std::move(wide_tables);
+    wide_atm_ = batches[0];
+    wide_ = wide;
+    wide_prepared_ = true;
+}
+
+namespace {
+BrunetonWideEvaluator MakeWideEvaluator(const AtmosphereParameters& atm,
+                                        const BrunetonConfig& config, const BrunetonTables& tables,
+                                        const WideCoefficients* wide) {
+    if (!wide) Fail("model bruneton: PrepareWide() must run before RenderWide() / SampleWide()");
+    BrunetonWideEvaluator e;
+    e.lut = MakeBrunetonLut(atm, config, tables);
+    e.w = *wide;
+    return e;
+}
+}  // namespace
+
+void BrunetonModel::RenderWide(const RenderRequest& request, std::vector<float>* values) const {
+    const BrunetonWideEvaluator e =
+        MakeWideEvaluator(wide_atm_, config_, wide_tables_, wide_prepared_ ? &wide_ : nullptr);
+    RenderWideImage(e, MakeWidePixelSetup(request, wide_atm_, e.w), values);
+}
+
+std::vector<float> BrunetonModel::SampleWide(const std::vector<SampleQuery>& queries) const {
+    const BrunetonWideEvaluator e =
+        MakeWideEvaluator(wide_atm_, config_, wide_tables_, wide_prepared_ ? &wide_ : nullptr);
+    return SampleAllWide(e, wide_atm_.bottom_radius, queries);
+}
 
 void BrunetonModel::Prepare(const AtmosphereParameters& atmosphere) {
     WarnOutsideValidityDomain(Info(), atmosphere);  // its declared domain (atmos/model.h)

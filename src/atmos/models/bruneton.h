@@ -43,6 +43,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
@@ -51,6 +52,7 @@
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
+#include "physics/wide.h"
 
 namespace atmos {
 
@@ -821,6 +823,13 @@ class BrunetonModel : public EvaluatorModel<BrunetonModel> {
     // only).
     bool TableSkyIrradiance(double altitude_m, double mu_s, Rgb* out) const override;
 
+    // Wide channel batches (models/bruneton_wide.h; separate Mie storage only).
+    void PrepareWide(const std::vector<AtmosphereParameters>& batches) override;
+    void RenderWide(const RenderRequest& request, std::vector<float>* values) const override;
+    std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
+    // The n-channel tables of the last PrepareWide (channel 3b + c: batch b's c).
+    const BrunetonTables& wide_tables() const { return wide_tables_; }
+
     const BrunetonConfig& config() const { return config_; }
     const BrunetonTables& tables() const { return tables_; }
 
@@ -830,6 +839,12 @@ class BrunetonModel : public EvaluatorModel<BrunetonModel> {
     AtmosphereParameters atm_;
     BrunetonTables tables_;
     bool prepared_ = false;
+    // PrepareWide's: batch 0's atmosphere, the per-channel coefficients, the
+    // n-channel tables.
+    AtmosphereParameters wide_atm_;
+    WideCoefficients wide_;
+    bool wide_prepared_ = false;
+    BrunetonTables wide_tables_;
 };
 
 }  // namespace atmos

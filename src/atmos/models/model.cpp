@@ -200,4 +200,16 @@ std::string Model::PassKey() const {
     Fail("model ", Info().name, " is not a Monte Carlo model: it has no pass key");
 }
 
+void Model::PrepareWide(const std::vector<AtmosphereParameters>&) {
+    Fail("model ", Info().name, " has no wide channel batches (capability wide_channels)");
+}
+
+void Model::RenderWide(const RenderRequest&, std::vector<float>*) const {
+    Fail("model ", Info().name, " has no wide channel batches (capability wide_channels)");
+}
+
+std::vector<float> Model::SampleWide(const std::vector<SampleQuery>&) const {
+    Fail("model ", Info().name, " has no wide channel batches (capability wide_channels)");
+}
+
 }  // namespace atmos

@@ -114,19 +114,18 @@ void BenchSpectral(const BenchConfig& c, Quantity quantity, BenchResult* result,
                 t0 = std::chrono::steady_clock::now();
                 model->Render(request, &image);
                 rr.push_back(Seconds(t0));
-                double prepare_s = 0.0;
+                // The render time of the batches (or wide groups) as the run
+                // measures it; the rest (model creation, Prepare or
+                // PrepareWide) is the precomputation.
+                std::vector<double> render_s;
                 t0 = std::chrono::steady_clock::now();
-                RenderSpectral(
-                    spec, spectral, c.wavelengths, request,
-                    [&](const AtmosphereParameters& a, Model* m) {
-                        const auto p0 = std::chrono::steady_clock::now();
-                        m->Prepare(a);
-                        prepare_s += Seconds(p0);
-                    },
-                    c.batching);
+                RenderSpectralRequests(
+                    spec, spectral, c.wavelengths, {request},
+                    [&](const AtmosphereParameters& a, Model* m) { m->Prepare(a); }, &render_s,
+                    nullptr, c.batching);
                 const double total = Seconds(t0);
-                sp.push_back(prepare_s);
-                sr.push_back(total - prepare_s);
+                sp.push_back(total - render_s.front());
+                sr.push_back(render_s.front());
             }
             BenchSpectralRow row;
             row.model = spec.text;

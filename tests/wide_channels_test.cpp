@@ -1,0 +1,145 @@
+// Wide channel batches (issue 37 item 1): a spectral run that prepares one
+// model for all its batches of three and evaluates every channel per ray gives
+// the values of the run with one model per batch, bit for bit.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "atmos/atmosphere.h"
+#include "atmos/error.h"
+#include "atmos/model.h"
+#include "atmos/spectral.h"
+#include "atmos/view.h"
+#include "base/parallel.h"
+#include "base/rng.h"
+#include "harness/spectral_run.h"
+#include "physics/wide.h"
+#include "test_util.h"
+
+namespace atmos {
+namespace {
+
+// Small tables: the precomputation of 3 batches in well under a second.
+const char* kSmallBruneton =
+    "bruneton:orders=2:scattering-samples=20:transmittance-width=32:transmittance-height=8:"
+    "irradiance-width=16:irradiance-height=4:scattering-r=8:scattering-mu=16:"
+    "scattering-mu-s=8:scattering-nu=4";
+
+SpectralBatching Batching(bool wide) {
+    SpectralBatching b;
+    b.wide = wide;
+    return b;
+}
+
+std::vector<SampleQuery> Queries() {
+    // Random queries over altitudes, view and sun angles (low suns included,
+    // where bruneton integrates single Mie along the segment), with and without
+    // the ground.
+    std::vector<SampleQuery> q;
+    Rng rng(37, 0, 0);
+    for (int i = 0; i < 64; ++i) {
+        SampleQuery s;
+        s.altitude_m = i % 8 == 0 ? 2e5 : 20000.0 * rng.Uniform();
+        s.mu = -1.0 + 2.0 * rng.Uniform();
+        s.mu_s = -0.25 + 1.25 * rng.Uniform();
+        if (i % 4 == 1) s.mu_s = 0.004 * rng.Uniform();
+        s.azimuth_deg = 360.0 * rng.Uniform();
+        s.ground = i % 2;
+        q.push_back(s);
+    }
+    return q;
+}
+
+void ExpectSameFloats(const std::vector<float>& a, const std::vector<float>& b) {
+    ASSERT_EQ(a.size(), b.size());
+    size_t differ = 0, first = a.size();
+    for (size_t i = 0; i < a.size(); ++i) {
+        if (std::memcmp(&a[i], &b[i], sizeof(float)) != 0) {
+            if (differ++ == 0) first = i;
+        }
+    }
+    EXPECT_EQ(differ, 0u) << "first at " << first << ": " << a[first] << " vs " << b[first];
+}
+
+class WideChannels : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(WideChannels, RenderAndSampleEqualTheThreeChannelBatchesBitForBit) {
+    const ModelSpec spec = ParseModelSpec(GetParam());
+    ASSERT_TRUE(UsesWideBatches(CreateModel(spec)->Info(), Batching(true)))
+        << "the wide path is not taken: the comparison would be of the batches with themselves";
+    const auto prepare = [](const AtmosphereParameters& a, Model* m) { m->Prepare(a); };
+    // 7 wavelengths: 3 batches, the last one short (it repeats a wavelength).
+    const std::vector<double> nm = {380, 420, 470, 530, 590, 660, 760};
+    for (const char* preset : {"kider-2013", "earth"}) {
+        SCOPED_TRACE(preset);
+        const SpectralAtmosphere spectral = LoadSpectralAtmosphere(preset);
+        const AtmosphereParameters rgb = LoadAtmosphere(preset);
+        for (int threads : {1, 2}) {
+            SCOPED_TRACE(threads);
+            ThreadLimit limit(threads);
+            for (const char* view : {"ground-sunrise", "plane-dawn", "space"}) {
+                for (Quantity quantity : {Quantity::kRadiance, Quantity::kTransmittance}) {
+                    SCOPED_TRACE(std::string(view) + " " + QuantityName(quantity));
+                    RenderRequest request = atmos_test::QuietRequest(GetView(view, rgb), 20, 12);
+                    request.quantity = quantity;
+                    request.sun_disc = true;
+                    const SpectralImage wide =
+                        RenderSpectral(spec, spectral, nm, request, prepare, Batching(true));
+                    const SpectralImage three =
+                        RenderSpectral(spec, spectral, nm, request, prepare, Batching(false));
+                    ExpectSameFloats(wide.values, three.values);
+                }
+            }
+            const std::vector<SampleQuery> queries = Queries();
+            const std::vector<double> wide =
+                SampleSpectral(spec, spectral, nm, queries, {}, prepare, Batching(true));
+            const std::vector<double> three =
+                SampleSpectral(spec, spectral, nm, queries, {}, prepare, Batching(false));
+            ASSERT_EQ(wide.size(), three.size());
+            size_t differ = 0;
+            for (size_t i = 0; i < wide.size(); ++i) {
+                if (std::memcmp(&wide[i], &three[i], sizeof(double)) != 0) ++differ;
+            }
+            EXPECT_EQ(differ, 0u);
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Models, WideChannels, ::testing::Values(kSmallBruneton),
+                         [](const ::testing::TestParamInfo<const char*>& param) {
+                             return ParseModelSpec(param.param).name + std::to_string(param.index);
+                         });
+});
+
+TEST(WideChannelBatches, MoreWavelengthsThanOneWideModelTakes) {
+    // 52 wavelengths: 18 batches, two wide groups (16 + 2).
+    const ModelSpec spec = ParseModelSpec(kSmallBruneton);
+    const SpectralAtmosphere spectral = LoadSpectralAtmosphere("kider-2013");
+    std::vector<double> nm;
+    for (int i = 0; i < 52; ++i) nm.push_back(380.0 + 8.0 * i);
+    const auto prepare = [](const AtmosphereParameters& a, Model* m) { m->Prepare(a); };
+    const std::vector<SampleQuery> queries = Queries();
+    EXPECT_EQ(SampleSpectral(spec, spectral, nm, queries, {}, prepare, Batching(true)),
+              SampleSpectral(spec, spectral, nm, queries, {}, prepare, Batching(false)));
+}
+
+TEST(WideChannelBatches, RefusesBatchesThatDifferBeyondTheirCoefficients) {
+    const SpectralAtmosphere spectral = LoadSpectralAtmosphere("kider-2013");
+    AtmosphereParameters a = spectral.AtWavelengths(400, 500, 600);
+    AtmosphereParameters b = spectral.AtWavelengths(450, 550, 650);
+    EXPECT_EQ(MakeWideCoefficients({a, b}).channels, 6);
+    EXPECT_EQ(MakeWideCoefficients({a, b}).rayleigh_scattering[4], b.rayleigh_scattering[1]);
+    b.mie_phase_g = 0.5;
+    EXPECT_THROW(MakeWideCoefficients({a, b}), Error);
+    EXPECT_THROW(MakeWideCoefficients({}), Error);
+    EXPECT_THROW(MakeWideCoefficients(std::vector<AtmosphereParameters>(17, a)), Error);
+    // A model without the capability refuses PrepareWide.
+    EXPECT_THROW(CreateModel("bruneton", {{"mie-storage", "combined"}})->PrepareWide({a}), Error);
+    EXPECT_FALSE(
+        CreateModel("bruneton", {{"mie-storage", "combined"}})->Info().capabilities.wide_channels);
+}
+
+}  // namespace
+}  // namespace atmos
