@@ -107,11 +107,11 @@ TEST_P(WideChannels, RenderAndSampleEqualTheThreeChannelBatchesBitForBit) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Models, WideChannels, ::testing::Values(kSmallBruneton),
+INSTANTIATE_TEST_SUITE_P(Models, WideChannels,
+                         ::testing::Values(kSmallBruneton, "naive", "naive:steps=7:light-steps=5"),
                          [](const ::testing::TestParamInfo<const char*>& param) {
                              return ParseModelSpec(param.param).name + std::to_string(param.index);
                          });
-});
 
 TEST(WideChannelBatches, MoreWavelengthsThanOneWideModelTakes) {
     // 52 wavelengths: 18 batches, two wide groups (16 + 2).

@@ -28,6 +28,8 @@
 // atmosphere, and everything runs in double.
 #pragma once
 
+#include <vector>
+
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "models/evaluator_model.h"
@@ -36,6 +38,7 @@
 #include "physics/phase.h"
 #include "physics/single_scattering.h"
 #include "physics/vector_exp.h"
+#include "physics/wide.h"
 
 namespace atmos {
 
@@ -192,6 +195,137 @@ struct NaiveEvaluator {
     }
 };
 
+// The wide evaluator (physics/wide.h; docs/models/naive.md "Wide channel
+// batches"): NaiveEvaluator::Evaluate for every channel of a wide batch. The
+// view ray's clip, sample positions, the three densities at each view sample
+// and the light rays' density sums (the bulk of the work: light_steps x 3
+// densities per view sample) are computed once per ray; per channel only the
+// optical depths (the coefficients times those densities), their exponentials
+// and the sums. Each channel's operations are the three-channel evaluator's,
+// in its order (ExpLane per value, double sums): a channel equals it bit for
+// bit.
+struct NaiveWideEvaluator {
+    NaiveEvaluator narrow;  // batch 0's atmosphere (its common fields), steps
+    WideCoefficients w;
+
+    ATMOS_HD int Channels() const { return w.channels; }
+
+    // NaiveEvaluator::LightDepth's density sums times ds (false: in the
+    // planet's shadow); tau per channel is the coefficients times these.
+    ATMOS_HD bool LightDensities(const NaiveEvaluator::Profiles& prof, const Vec3d& p,
+                                 const Vec3d& sun, double* d_r, double* d_m, double* d_o) const {
+        const AtmosphereParameters& atm = narrow.atm;
+        const double r = Length(p);
+        const double mu_s = ClampCosine(Dot(p, sun) / r);
+        if (RayIntersectsGround(r, mu_s, atm.bottom_radius)) return false;
+        const double length = DistanceToTopAtmosphereBoundary(r, mu_s, atm.top_radius);
+        const double ds = length / narrow.light_steps;
+        const double r2 = r * r;
+        const double b = 2.0 * r * mu_s;
+        double sr, sm, so;
+        if (prof.ozone.any_exp) {
+            narrow.LightSums<true>(prof, r2, b, ds, &sr, &sm, &so);
+        } else {
+            narrow.LightSums<false>(prof, r2, b, ds, &sr, &sm, &so);
+        }
+        *d_r = sr * ds;
+        *d_m = sm * ds;
+        *d_o = so * ds;
+        return true;
+    }
+    // Extinction (physics/density.h) of channel c at densities (r, m, o).
+    ATMOS_HD double Ext(int c, double r, double m, double o) const {
+        return w.rayleigh_scattering[c] * r + w.mie_extinction[c] * m +
+               w.absorption_extinction[c] * o;
+    }
+    // The direct sun on the ground at g (FinishSingleScattering and
+    // SingleScatteringGroundAtCamera), times t_view when given.
+    ATMOS_HD void Ground(const NaiveEvaluator::Profiles& prof, const Vec3d& g, const Vec3d& sun,
+                         const double* t_view, WideRayResult* out) const {
+        const int n = w.channels;
+        bool any = false;
+        for (int b = 0; b < n / 3; ++b) any = any || w.BatchMaxAlbedo(b) > 0.0;
+        if (!any) return;
+        const double cos_sun = Dot(Normalize(g), sun);
+        double d_r, d_m, d_o;
+        if (!(cos_sun > 0.0 && LightDensities(prof, g, sun, &d_r, &d_m, &d_o))) return;
+        for (int b = 0; b < n / 3; ++b) {
+            if (!(w.BatchMaxAlbedo(b) > 0.0)) continue;
+            for (int c = 3 * b; c < 3 * b + 3; ++c) {
+                const double v = w.ground_albedo[c] * (cos_sun / kPi) * Exp(-Ext(c, d_r, d_m, d_o));
+                out->ground[c] = static_cast<float>(t_view ? v * t_view[c] : v);
+            }
+        }
+    }
+
+    ATMOS_HD void EvaluateWide(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                               bool want_ground, WideRayResult* out) const {
+        const AtmosphereParameters& atm = narrow.atm;
+        const int n = w.channels;
+        for (int c = 0; c < n; ++c) {
+            out->sky[c] = 0.0f;
+            out->ground[c] = 0.0f;
+            out->transmittance[c] = 1.0f;
+        }
+        const NaiveEvaluator::Profiles prof(atm);
+        const AtmosphereSegment seg =
+            ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
+        out->hits_ground = seg.hits_ground;
+        if (!seg.inside) {
+            if (want_ground && GroundAtCamera(seg)) Ground(prof, camera, sun, nullptr, out);
+            return;
+        }
+        constexpr int kL = NaiveEvaluator::kLightLanes;
+        const double inf = HUGE_VAL;
+        const int steps = narrow.steps;
+        const double ds = (seg.t_end - seg.t_start) / steps;
+        double tau_view[kMaxWideChannels], sum_r[kMaxWideChannels], sum_m[kMaxWideChannels];
+        for (int c = 0; c < n; ++c) tau_view[c] = sum_r[c] = sum_m[c] = 0.0;
+        for (int i0 = 0; i0 < steps; i0 += kL) {
+            double rho_r[kL], rho_m[kL], rho_o[kL];
+            if (prof.ozone.any_exp) {
+                narrow.ViewDensities<true>(prof, camera, dir, seg.t_start, i0, ds, rho_r, rho_m,
+                                           rho_o);
+            } else {
+                narrow.ViewDensities<false>(prof, camera, dir, seg.t_start, i0, ds, rho_r, rho_m,
+                                            rho_o);
+            }
+            const int lanes = Min(kL, steps - i0);
+            for (int k = 0; k < lanes; ++k) {
+                const Vec3d p = camera + dir * (seg.t_start + (i0 + k + 0.5) * ds);
+                double l_r, l_m, l_o;
+                const bool lit = LightDensities(prof, p, sun, &l_r, &l_m, &l_o);
+                const double wr = rho_r[k] * ds, wm = rho_m[k] * ds;
+                double t[kMaxWideChannels];
+                for (int c = 0; c < n; ++c) {
+                    const double ext = Ext(c, rho_r[k], rho_m[k], rho_o[k]);
+                    const double tau_mid = tau_view[c] + ext * (0.5 * ds);
+                    tau_view[c] += ext * ds;
+                    t[c] = lit ? tau_mid + Ext(c, l_r, l_m, l_o) : inf;
+                }
+                ATMOS_SIMD
+                for (int c = 0; c < n; ++c) t[c] = ExpLane(-t[c]);
+                for (int c = 0; c < n; ++c) {
+                    sum_r[c] += t[c] * wr;
+                    sum_m[c] += t[c] * wm;
+                }
+            }
+        }
+        // FinishSingleScattering.
+        const double nu = Dot(dir, sun);
+        const double pr = RayleighPhase(nu), pm = MiePhase(atm, nu);
+        double t_view[kMaxWideChannels];
+        for (int c = 0; c < n; ++c) {
+            out->sky[c] = static_cast<float>(w.rayleigh_scattering[c] * sum_r[c] * pr +
+                                             w.mie_scattering[c] * sum_m[c] * pm);
+            t_view[c] = Exp(-tau_view[c]);
+            out->transmittance[c] = static_cast<float>(t_view[c]);
+        }
+        if (want_ground && seg.hits_ground)
+            Ground(prof, camera + dir * seg.t_end, sun, t_view, out);
+    }
+};
+
 struct NaiveOptions {
     int steps = 16;       // view-ray samples
     int light_steps = 8;  // light-ray samples
@@ -210,6 +344,16 @@ class NaiveModel : public SimpleEvaluatorModel<NaiveModel, NaiveEvaluator> {
         clipped.top_radius = EffectiveTopRadius(atmosphere);
         SetAtmosphere(clipped);
     }
+
+    // Wide channel batches (NaiveWideEvaluator).
+    void PrepareWide(const std::vector<AtmosphereParameters>& batches) override;
+    void RenderWide(const RenderRequest& request, std::vector<float>* values) const override;
+    std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
+
+  private:
+    std::vector<AtmosphereParameters> wide_batches_;  // as Prepare() clips each
+    bool wide_shared_ = false;                        // the batches' shells end at the same radius
+    NaiveWideEvaluator wide_;
 };
 
 }  // namespace atmos
