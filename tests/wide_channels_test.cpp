@@ -3,7 +3,12 @@
 // the values of the run with one model per batch, bit for bit.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <ctime>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -139,6 +144,106 @@ TEST(WideChannelBatches, RefusesBatchesThatDifferBeyondTheirCoefficients) {
     EXPECT_THROW(CreateModel("bruneton", {{"mie-storage", "combined"}})->PrepareWide({a}), Error);
     EXPECT_FALSE(
         CreateModel("bruneton", {{"mie-storage", "combined"}})->Info().capabilities.wide_channels);
+}
+
+// The cost study behind docs/performance.md "Wide channel batches" (slow: run
+// by name, `--gtest_also_run_disabled_tests --gtest_filter='*DISABLED_Cost*'`;
+// ATMOS_WIDE_COST_MODEL picks the model, default bruneton:orders=1, whose
+// lookups are the default bruneton's with a fifth of its precomputation). One
+// thread; CPU seconds (std::clock) of each frame and sample batch, medians of
+// ATMOS_WIDE_COST_ROUNDS (default 5) rounds, each round RGB, the 40
+// wavelengths in batches of three (14 prepared models) and wide (one model),
+// interleaved; the models are prepared once, outside the timing.
+TEST(WideChannelBatches, DISABLED_Cost) {
+    const char* env_model = std::getenv("ATMOS_WIDE_COST_MODEL");
+    const char* env_rounds = std::getenv("ATMOS_WIDE_COST_ROUNDS");
+    const ModelSpec spec = ParseModelSpec(env_model ? env_model : "bruneton:orders=1");
+    const int rounds = env_rounds ? std::atoi(env_rounds) : 5;
+    ThreadLimit limit(1);
+    const SpectralAtmosphere spectral = LoadSpectralAtmosphere("earth");
+    const AtmosphereParameters rgb = LoadAtmosphere("earth");
+    std::vector<double> nm;
+    for (int i = 0; i < 40; ++i) nm.push_back(380.0 + 400.0 * i / 39.0);
+    const auto batches = SpectralBatches(nm.size(), BatchLayout::kInterleaved);
+    const auto cpu = [] { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; };
+    double t0 = cpu();
+    std::unique_ptr<Model> rgb_model = CreateModel(spec);
+    rgb_model->Prepare(rgb);
+    const double rgb_prepare = cpu() - t0;
+    std::vector<std::unique_ptr<Model>> three;
+    std::vector<AtmosphereParameters> atms;
+    t0 = cpu();
+    for (const auto& b : batches) {
+        atms.push_back(spectral.AtWavelengths(nm[b[0]], nm[b[1]], nm[b[2]]));
+        three.push_back(CreateModel(spec));
+        three.back()->Prepare(atms.back());
+    }
+    const double three_prepare = cpu() - t0;
+    std::unique_ptr<Model> wide = CreateModel(spec);
+    t0 = cpu();
+    wide->PrepareWide(atms);
+    const double wide_prepare = cpu() - t0;
+    std::printf(
+        "%s prepare CPU s: rgb %.3f, 40 wavelengths in batches %.3f (x%.1f), wide %.3f "
+        "(x%.1f)\n",
+        spec.text.c_str(), rgb_prepare, three_prepare, three_prepare / rgb_prepare, wide_prepare,
+        wide_prepare / rgb_prepare);
+    const auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        return v[v.size() / 2];
+    };
+    const auto report = [&](const std::string& what, double units, const std::vector<double>& r,
+                            const std::vector<double>& t, const std::vector<double>& w) {
+        const double mr = median(r), mt = median(t), mw = median(w);
+        std::printf(
+            "%-16s rgb %8.1f ns, batches %9.1f ns (x%.2f), wide %9.1f ns (x%.2f); per "
+            "channel: rgb %.1f, wide %.1f ns\n",
+            what.c_str(), mr / units * 1e9, mt / units * 1e9, mt / mr, mw / units * 1e9, mw / mr,
+            mr / units * 1e9 / 3, mw / units * 1e9 / 40);
+    };
+    for (const char* view : {"ground-noon", "ground-sunrise", "plane-dawn", "space"}) {
+        RenderRequest request = atmos_test::QuietRequest(GetView(view, rgb), 240, 135);
+        std::vector<double> r, t, w;
+        for (int round = 0; round < rounds; ++round) {
+            Image image;
+            t0 = cpu();
+            rgb_model->Render(request, &image);
+            r.push_back(cpu() - t0);
+            t0 = cpu();
+            for (const auto& m : three) m->Render(request, &image);
+            t.push_back(cpu() - t0);
+            std::vector<float> values;
+            t0 = cpu();
+            wide->RenderWide(request, &values);
+            w.push_back(cpu() - t0);
+        }
+        report(std::string(view) + " px", 240.0 * 135.0, r, t, w);
+    }
+    // Queries as bench/query_cost.py draws them (altitude 0-20 km, mu in
+    // [-0.3, 1], mu_s in [-0.2, 1]).
+    std::vector<SampleQuery> queries;
+    Rng rng(19, 0, 0);
+    for (int i = 0; i < 20000; ++i) {
+        SampleQuery q;
+        q.altitude_m = 20000.0 * rng.Uniform();
+        q.mu = -0.3 + 1.3 * rng.Uniform();
+        q.mu_s = -0.2 + 1.2 * rng.Uniform();
+        q.azimuth_deg = 360.0 * rng.Uniform();
+        queries.push_back(q);
+    }
+    std::vector<double> r, t, w;
+    for (int round = 0; round < rounds; ++round) {
+        t0 = cpu();
+        rgb_model->Sample(queries);
+        r.push_back(cpu() - t0);
+        t0 = cpu();
+        for (const auto& m : three) m->Sample(queries);
+        t.push_back(cpu() - t0);
+        t0 = cpu();
+        wide->SampleWide(queries);
+        w.push_back(cpu() - t0);
+    }
+    report("sample query", static_cast<double>(queries.size()), r, t, w);
 }
 
 }  // namespace
