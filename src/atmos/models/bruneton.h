@@ -52,6 +52,7 @@
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
+#include "physics/vector_exp.h"
 #include "physics/wide.h"
 
 namespace atmos {
@@ -705,7 +706,9 @@ struct BrunetonLut {
             const Vec3d tau_mid = tau + ext * (0.5 * dt);
             tau += ext * dt;
             const Rgb ts = TransmittanceToSun(r_t, ClampCosine((r * mu_s + t * nu) / r_t));
-            sum += Vec3d(ts) * Exp(-tau_mid) * (rho.mie * dt);
+            // ExpLane (physics/vector_exp.h): the wide evaluator's channels
+            // take it in a vector loop; within 1 ulp of std::exp.
+            sum += Vec3d(ts) * ExpLane(-tau_mid) * (rho.mie * dt);
         }
         return Rgb(sum * atm.mie_scattering);
     }

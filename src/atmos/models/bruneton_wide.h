@@ -158,7 +158,8 @@ struct BrunetonWideEvaluator {
         const float pm = static_cast<float>(MiePhase(atm, nu));
         for (int c = 0; c < n; ++c) out[c] = scattering[c] * pr + single_mie[c] * pm;
     }
-    // SegmentSingleMie (double precision per channel, as the Vec3d original).
+    // SegmentSingleMie (double precision per channel, as the Vec3d original; the
+    // exponentials of all channels in one vector loop).
     ATMOS_HD void SegmentSingleMie(double r, double mu, double mu_s, double nu, double d,
                                    float* out) const {
         const AtmosphereParameters& atm = lut.atm;
@@ -174,14 +175,17 @@ struct BrunetonWideEvaluator {
             const Densities rho = GetDensities(atm, r_t - atm.bottom_radius);
             TransmittanceToSun(r_t, ClampCosine((r * mu_s + t * nu) / r_t), ts);
             const double m = rho.mie * dt;
+            double e[kMaxWideChannels];
             for (int c = 0; c < n; ++c) {
                 const double ext = w.rayleigh_scattering[c] * rho.rayleigh +
                                    w.mie_extinction[c] * rho.mie +
                                    w.absorption_extinction[c] * rho.absorption;
-                const double tau_mid = tau[c] + ext * (0.5 * dt);
+                e[c] = -(tau[c] + ext * (0.5 * dt));  // -tau_mid
                 tau[c] += ext * dt;
-                sum[c] += static_cast<double>(ts[c]) * Exp(-tau_mid) * m;
             }
+            ATMOS_SIMD
+            for (int c = 0; c < n; ++c) e[c] = ExpLane(e[c]);
+            for (int c = 0; c < n; ++c) sum[c] += static_cast<double>(ts[c]) * e[c] * m;
         }
         for (int c = 0; c < n; ++c) out[c] = static_cast<float>(sum[c] * w.mie_scattering[c]);
     }
