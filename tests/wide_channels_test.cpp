@@ -130,6 +130,32 @@ TEST(WideChannelBatches, MoreWavelengthsThanOneWideModelTakes) {
               SampleSpectral(spec, spectral, nm, queries, {}, prepare, Batching(false)));
 }
 
+TEST(WideChannelBatches, NaiveRunsTheBatchesWhereTheirShellsDiffer) {
+    // A shell of 5640 km over kider-2013's air: each batch's EffectiveTopRadius
+    // (where its column's optical depth ends) depends on its coefficients, so
+    // the rays of the batches differ and naive's wide model runs them one by
+    // one; the values are still the batches'.
+    const SpectralAtmosphere spectral =
+        LoadSpectralAtmosphere("kider-2013", {"top_radius=12000000"});
+    const std::vector<double> nm = {380, 420, 470, 530, 590, 660, 760};
+    const auto batches = SpectralBatches(nm.size(), BatchLayout::kInterleaved);
+    const auto top = [&](size_t b) {
+        return EffectiveTopRadius(
+            spectral.AtWavelengths(nm[batches[b][0]], nm[batches[b][1]], nm[batches[b][2]]));
+    };
+    ASSERT_NE(top(0), top(1)) << "the shells agree: the test would not reach its case";
+    const ModelSpec spec = ParseModelSpec("naive");
+    const auto prepare = [](const AtmosphereParameters& a, Model* m) { m->Prepare(a); };
+    std::vector<SampleQuery> queries = Queries();
+    EXPECT_EQ(SampleSpectral(spec, spectral, nm, queries, {}, prepare, Batching(true)),
+              SampleSpectral(spec, spectral, nm, queries, {}, prepare, Batching(false)));
+    const AtmosphereParameters rgb = spectral.AtWavelengths(680, 550, 440);
+    RenderRequest request = atmos_test::QuietRequest(GetView("ground-sunrise", rgb), 20, 12);
+    request.sun_disc = true;
+    ExpectSameFloats(RenderSpectral(spec, spectral, nm, request, prepare, Batching(true)).values,
+                     RenderSpectral(spec, spectral, nm, request, prepare, Batching(false)).values);
+}
+
 TEST(WideChannelBatches, RefusesBatchesThatDifferBeyondTheirCoefficients) {
     const SpectralAtmosphere spectral = LoadSpectralAtmosphere("kider-2013");
     AtmosphereParameters a = spectral.AtWavelengths(400, 500, 600);
