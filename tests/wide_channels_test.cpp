@@ -118,6 +118,28 @@ INSTANTIATE_TEST_SUITE_P(Models, WideChannels,
                              return ParseModelSpec(param.param).name + std::to_string(param.index);
                          });
 
+TEST(WideChannelBatches, BrunetonPreparesEachBatchThroughTheRunsPrepareFunction) {
+    // The CLI's prepare function goes through the table cache (or --load):
+    // the wide model gathers the batches' tables through it, one call per
+    // batch, as the three-channel path makes them.
+    const SpectralAtmosphere spectral = LoadSpectralAtmosphere("kider-2013");
+    const std::vector<double> nm = {380, 420, 470, 530, 590, 660, 760};
+    int calls = 0;
+    const auto prepare = [&](const AtmosphereParameters& a, Model* m) {
+        ++calls;
+        m->Prepare(a);
+    };
+    const std::vector<SampleQuery> queries = Queries();
+    const std::vector<double> wide = SampleSpectral(ParseModelSpec(kSmallBruneton), spectral, nm,
+                                                    queries, {}, prepare, Batching(true));
+    EXPECT_EQ(calls, 3);
+    // A prepare function that leaves the model unprepared is refused.
+    EXPECT_THROW(SampleSpectral(
+                     ParseModelSpec(kSmallBruneton), spectral, nm, queries, {},
+                     [](const AtmosphereParameters&, Model*) {}, Batching(true)),
+                 Error);
+}
+
 TEST(WideChannelBatches, MoreWavelengthsThanOneWideModelTakes) {
     // 52 wavelengths: 18 batches, two wide groups (16 + 2).
     const ModelSpec spec = ParseModelSpec(kSmallBruneton);

@@ -241,10 +241,17 @@ class Model {
     // atmos::Error). PrepareWide prepares for 3 x batches.size() channels at
     // once (at most kMaxWideChannels): batch b's atmosphere gives channels 3b ..
     // 3b + 2; the batches differ only in their per-channel coefficients
-    // (AtWavelengths), else it throws naming the field. RenderWide renders as
-    // Render, every channel (values[pixel * channels + c], resized);
-    // SampleWide answers as Sample's radiance ([query * channels + c]).
-    virtual void PrepareWide(const std::vector<AtmosphereParameters>& batches);
+    // (AtWavelengths), else it throws naming the field. `prepare_batch`
+    // (optional): how one batch is prepared, the spectral run's prepare
+    // function (the CLI's: through the table cache, or --load): a model that
+    // gathers per-batch tables (bruneton) calls it with each batch's
+    // atmosphere and a fresh model of its own kind and options; empty:
+    // Prepare(). RenderWide renders as Render, every channel
+    // (values[pixel * channels + c], resized); SampleWide answers as Sample's
+    // radiance ([query * channels + c]).
+    using BatchPrepare = std::function<void(const AtmosphereParameters&, Model*)>;
+    virtual void PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                             const BatchPrepare& prepare_batch = {});
     virtual void RenderWide(const RenderRequest& request, std::vector<float>* values) const;
     virtual std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const;
 

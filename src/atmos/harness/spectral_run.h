@@ -58,7 +58,8 @@ BatchLayout ParseBatchLayout(const std::string& text);  // "consecutive" or "int
 // `wide`: a model with wide channel batches (ModelCapabilities::wide_channels;
 // deterministic, on the CPU backend) is prepared once for up to
 // kMaxWideChannels / 3 batches and evaluates all their channels per ray
-// (Model::PrepareWide; the `prepare` function is then not called): the same
+// (Model::PrepareWide, given `prepare` for the models that gather per-batch
+// tables: bruneton's batches still go through the CLI's table cache): the same
 // values bit for bit, the geometry computed once per ray instead of once per
 // batch. false: one model per batch of three, as every other model.
 struct SpectralBatching {

@@ -144,15 +144,24 @@ void GatherChannels(const Table& batch, int b, int channels, Table* wide) {
 
 }  // namespace
 
-void BrunetonModel::PrepareWide(const std::vector<AtmosphereParameters>& batches) {
-    if (!info_.capabilities.wide_channels) Model::PrepareWide(batches);
+void BrunetonModel::PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                                const BatchPrepare& prepare_batch) {
+    if (!info_.capabilities.wide_channels) Model::PrepareWide(batches, prepare_batch);
     const WideCoefficients wide = MakeWideCoefficients(batches);
-    for (const AtmosphereParameters& a : batches) WarnOutsideValidityDomain(Info(), a);
-    // The tables of each batch, as Prepare() computes them, side by side.
+    // The tables of each batch, as Prepare() computes them (or the spectral
+    // run's prepare function: the table cache, --load), side by side.
     BrunetonTables wide_tables;
     for (size_t b = 0; b < batches.size(); ++b) {
-        BrunetonTables t;
-        PrecomputeBruneton(batches[b], config_, &t);
+        BrunetonModel batch_model(config_);
+        if (prepare_batch) {
+            prepare_batch(batches[b], &batch_model);
+        } else {
+            batch_model.Prepare(batches[b]);
+        }
+        if (!batch_model.prepared_) {
+            Fail("model bruneton: the prepare function of a wide batch left its tables empty");
+        }
+        const BrunetonTables& t = batch_model.tables_;
         const int bi = static_cast<int>(b);
         GatherChannels(t.transmittance, bi, wide.channels, &wide_tables.transmittance);
         GatherChannels(t.irradiance, bi, wide.channels, &wide_tables.irradiance);

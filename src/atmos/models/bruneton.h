@@ -827,7 +827,8 @@ class BrunetonModel : public EvaluatorModel<BrunetonModel> {
     bool TableSkyIrradiance(double altitude_m, double mu_s, Rgb* out) const override;
 
     // Wide channel batches (models/bruneton_wide.h; separate Mie storage only).
-    void PrepareWide(const std::vector<AtmosphereParameters>& batches) override;
+    void PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                     const BatchPrepare& prepare_batch = {}) override;
     void RenderWide(const RenderRequest& request, std::vector<float>* values) const override;
     std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
     // The n-channel tables of the last PrepareWide (channel 3b + c: batch b's c).

@@ -200,7 +200,7 @@ std::string Model::PassKey() const {
     Fail("model ", Info().name, " is not a Monte Carlo model: it has no pass key");
 }
 
-void Model::PrepareWide(const std::vector<AtmosphereParameters>&) {
+void Model::PrepareWide(const std::vector<AtmosphereParameters>&, const BatchPrepare&) {
     Fail("model ", Info().name, " has no wide channel batches (capability wide_channels)");
 }
 

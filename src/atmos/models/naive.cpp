@@ -36,7 +36,9 @@ NaiveModel::NaiveModel(const NaiveOptions& options) {
     evaluator_.light_steps = options.light_steps;
 }
 
-void NaiveModel::PrepareWide(const std::vector<AtmosphereParameters>& batches) {
+void NaiveModel::PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                             const BatchPrepare&) {
+    // No tables: each batch's Prepare() is its clipped atmosphere, made here.
     std::vector<AtmosphereParameters> clipped;
     for (const AtmosphereParameters& a : batches) {
         WarnOutsideValidityDomain(Info(), a);

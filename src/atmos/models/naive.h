@@ -346,7 +346,8 @@ class NaiveModel : public SimpleEvaluatorModel<NaiveModel, NaiveEvaluator> {
     }
 
     // Wide channel batches (NaiveWideEvaluator).
-    void PrepareWide(const std::vector<AtmosphereParameters>& batches) override;
+    void PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                     const BatchPrepare& prepare_batch = {}) override;
     void RenderWide(const RenderRequest& request, std::vector<float>* values) const override;
     std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
 
