@@ -14,7 +14,9 @@
 //      main() that calls atmos_Evaluate per pixel (ShadePixel of `atmos render`);
 //   5. per frame, for a model with frame tables (hillaire), the sky-view pass and
 //      the 32 aerial-perspective slice passes, then the sky pass;
-//   6. readback (rows bottom to top, as PFM stores them).
+//   6. readback (rows bottom to top, as PFM stores them);
+//   7. with --precompute, instead, the bake's "gpu_precompute" passes: the
+//      tables computed on the GPU (docs/engine.md, "Tables computed on the GPU").
 // It links the system's libEGL and libOpenGL (glvnd) and nlohmann/json; nothing
 // of atmos. Usage: `atmos_gl_host --help`.
 #define GL_GLEXT_PROTOTYPES 1
