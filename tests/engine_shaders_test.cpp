@@ -3,7 +3,8 @@
 // Every stage compiles here with glslangValidator -V on its own, its SPIR-V passes
 // spirv-val, and every HLSL file compiles back to SPIR-V with glslang's HLSL front
 // end (the round trip). Skipped when Debian's glslang-tools / spirv-cross are absent.
-// And every pass of bruneton's GPU precomputation compiles as GLSL 3.30 and ES 3.00.
+// bruneton's GPU precomputation (its "gpu_precompute" passes) is one more fragment
+// stage, and every pass also compiles as GLSL 3.30 and ES 3.00.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -47,7 +48,7 @@ TEST(EngineShaders, EveryStageCompilesAndTranslates) {
     const BakeCase cases[] = {
         {"bruneton",
          "bruneton:orders=1:scattering-r=4:scattering-mu=8:scattering-mu-s=4:scattering-nu=2",
-         {"bruneton.vert", "bruneton.frag"}},
+         {"bruneton.vert", "bruneton.frag", "bruneton_precompute.frag"}},
         {"hillaire",
          "hillaire",
          {"hillaire.vert", "hillaire.frag", "hillaire_sky_view.comp",
@@ -117,6 +118,15 @@ TEST(EngineShaders, EveryStageCompilesAndTranslates) {
             EXPECT_EQ(RunShellCommand("spirv-val --target-env vulkan1.0 " + back.string(), &out), 0)
                 << hlsl << ": " << out;
             const std::string hlsl_text = Slurp(hlsl);
+            if (stage.find("_precompute.") != std::string::npos) {
+                // Every pass of "gpu_precompute" in one stage, selected by
+                // specialization constant 0 (HLSL: a define; Metal: a function constant).
+                EXPECT_NE(hlsl_text.find("SPIRV_CROSS_CONSTANT_ID_0"), std::string::npos) << hlsl;
+                EXPECT_NE(metal_text.find("[[function_constant(0)]]"), std::string::npos) << metal;
+                EXPECT_NE(text.find("if (ATMOS_PASS == 0) atmos_pass_0();  // ATMOS_PASS_"),
+                          std::string::npos)
+                    << source;
+            }
             if (kind != "vert") {  // the full-screen triangle reads no uniform
                 EXPECT_NE(hlsl_text.find("cbuffer AtmosFrame : register(b0)"), std::string::npos)
                     << hlsl;

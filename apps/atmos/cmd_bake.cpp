@@ -70,9 +70,11 @@ std::string BakeInto(const CommonOptions& common, const std::string& dir) {
             fs::create_directories(into / "shaders");
             WriteText(into / ShaderAsset(spec.name), shader);
             WriteText(into / kCommonShader, FindAsset(kCommonShader));
+            InstallPrecomputeShaders(into);
             WriteEngineShaders(into.string(), spec.name, common.quiet);  // Vulkan, HLSL, Metal
+        } else {
+            InstallPrecomputeShaders(into);
         }
-        InstallPrecomputeShaders(into);
     });
     staged.Commit();
     if (!common.quiet) {
