@@ -180,6 +180,7 @@ Command AddViewerCommand(CLI::App* root) {
             WriteText(into / "index.html", FindAsset("viewer/index.html"));
             WriteText(into / "viewer.js", FindAsset("viewer/viewer.js"));
             WriteText(into / "models.js", "var atmosViewerModels = [" + list + "];\n");
+            WriteText(into / "presets.js", ViewerPresetsScript());
         });
         staged.Commit();
         if (!common->quiet) {
