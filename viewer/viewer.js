@@ -493,7 +493,9 @@ function linkPrecompute(gl, model, constants) {
     return data.sources[path];
   }).join('\n');
   pc.programs = pc.spec.passes.map(function (pass) {
-    var program = linkProgram(gl, GLSL_HEADER + '#define ' + pass.entry + ' 1\n' + body);
+    // The schema's header: #version, the precision lines (int too), the entry.
+    var program = linkProgram(gl, GLSL_HEADER + 'precision highp int;\n#define ' + pass.entry +
+                                      ' 1\n' + body);
     gl.useProgram(program);
     Object.keys(pass.inputs).forEach(function (sampler, unit) {
       gl.uniform1i(gl.getUniformLocation(program, sampler), unit);
