@@ -1230,17 +1230,25 @@ function runViewer(gl, canvas, format, blobs) {
     atmosphereKey = key;
     var fixed = [];
     atmosViewerModels.forEach(function (name) {
-      var ok = applyAtmosphere(gl, models[name], state, timer, function (ms) {
-        precomputeMs[name] = ms;
-        showPrecompute();
-      });
-      if (!ok) fixed.push(name);
+      try {
+        var ok = applyAtmosphere(gl, models[name], state, timer, function (ms) {
+          precomputeMs[name] = ms;
+          showPrecompute();
+        });
+        if (!ok) fixed.push(name);
+      } catch (e) {
+        // No float render targets, or a pass that does not compile: the
+        // model keeps what it had, and the page says why.
+        el('error').textContent = name + ': ' + String(e.message || e);
+        fixed.push(name);
+      }
     });
     // The views follow the planet (the first model's).
     R = models[atmosViewerModels[0]].bottom;
     views = standardViews(R, models[atmosViewerModels[0]].top);
     el('atm_note').textContent = fixed.length ?
-        'baked atmosphere kept (no GPU passes in the bake): ' + fixed.join(', ') : '';
+        'baked atmosphere kept (no GPU passes in its bake, or the error below): ' +
+        fixed.join(', ') : '';
   }
   function showPrecompute() {
     var parts = [];
