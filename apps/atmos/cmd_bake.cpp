@@ -75,6 +75,7 @@ std::string BakeInto(const CommonOptions& common, const std::string& dir) {
         } else {
             InstallPrecomputeShaders(into);
         }
+        InstallPrecomputeShaders(into);
     });
     staged.Commit();
     if (!common.quiet) {
@@ -182,6 +183,7 @@ Command AddViewerCommand(CLI::App* root) {
             WriteText(into / "index.html", FindAsset("viewer/index.html"));
             WriteText(into / "viewer.js", FindAsset("viewer/viewer.js"));
             WriteText(into / "models.js", "var atmosViewerModels = [" + list + "];\n");
+            WriteText(into / "presets.js", ViewerPresetsScript());
         });
         staged.Commit();
         if (!common->quiet) {
