@@ -47,6 +47,10 @@ vec3 atmos_ExtinctionAt(float altitude) {
            ATMOS_ABSORPTION_EXTINCTION * d.z;
 }
 
+// ---- passes ----
+// (Above: helpers every pass shares; below: each pass's main(). The Vulkan
+// stage, src/atmos/io/engine_shaders.cpp PrecomputeStage, splits here.)
+
 #ifdef ATMOS_HILLAIRE_TRANSMITTANCE
 // HillaireTransmittanceStage (Bruneton's 2017 implementation notes
 // ComputeTransmittanceToTopAtmosphereBoundaryTexture): texel (i, j) is
