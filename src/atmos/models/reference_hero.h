@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "models/reference_hybrid.h"
+#include "physics/vector_exp.h"
 
 namespace atmos {
 
@@ -109,10 +110,12 @@ struct ReferenceHero : ReferenceHybrid {
         if (!(pr + pm > 0.0)) return;
         Vec3d column;
         if (!SunColumnsAt(p, sun, &column)) return;
+        // Every channel (a zero weight adds zero): a loop that vectorises
+        // (ExpLane: physics/vector_exp.h).
+        ATMOS_SIMD
         for (int c = 0; c < spec.count; ++c) {
-            if (!(weight[c] > 0.0)) continue;
             const double scatter = spec.rayleigh[c] * pr + spec.mie_scattering[c] * pm;
-            out[c] += weight[c] * scatter * factor * exp(-Tau(column, c));
+            out[c] += weight[c] * scatter * factor * ExpLane(-Tau(column, c));
         }
     }
 
@@ -178,7 +181,7 @@ struct ReferenceHero : ReferenceHybrid {
                 if (cos_sun > 0.0 && SunColumnsAt(p, sun, &column)) {
                     for (int c = 0; c < n; ++c) {
                         radiance[c] +=
-                            w[c] * spec.albedo[c] * (cos_sun / kPi) * exp(-Tau(column, c));
+                            w[c] * spec.albedo[c] * (cos_sun / kPi) * ExpLane(-Tau(column, c));
                     }
                 }
                 dir = MakeDirection(normal, SampleCosineHemisphereCosine(rng.Uniform()),
@@ -304,7 +307,7 @@ struct ReferenceHero : ReferenceHybrid {
         double t_end[kHeroMaxChannels];
         double ground_mass = 0.0;
         for (int c = 0; c < n; ++c) {
-            t_end[c] = exp(-Tau(column_end, c));
+            t_end[c] = ExpLane(-Tau(column_end, c));
             ground_mass += t_end[c] * spec.albedo[c];
         }
         ground_mass = reflective ? ground_mass / n : 0.0;
@@ -348,7 +351,7 @@ struct ReferenceHero : ReferenceHybrid {
             const double pdf = (1.0 - p_ground) * p_interval / width;
             double a_r = 0.0, a_m = 0.0;
             for (int c = 0; c < n; ++c) {
-                w[c] = exp(-Tau(column, c)) * (1.0 / pdf);
+                w[c] = ExpLane(-Tau(column, c)) * (1.0 / pdf);
                 a_r += w[c] * spec.rayleigh[c] * d.rayleigh;
                 a_m += w[c] * spec.mie_scattering[c] * d.mie;
             }
