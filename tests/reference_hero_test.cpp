@@ -15,6 +15,7 @@
 #include "base/parallel.h"
 #include "harness/spectral_run.h"
 #include "models/reference.h"
+#include "physics/density.h"
 #include "test_util.h"
 
 namespace atmos {
@@ -126,6 +127,70 @@ TEST(ReferenceHero, AgreesWithBatchesOnMarsAndTitan) {
 }
 
 TEST(ReferenceHero, AgreesWithBatchesOnThickVenusAtLowSpp) { ExpectAgree("venus", 6, 2, 16); }
+
+// Energy, exact: a conservatively scattering slab (Rayleigh only, a black
+// ground) under a zenith sun reflects and transmits all it receives in every
+// channel, R + T = 1 (as ReferenceThick.ConservativeSlab...: the upwelling
+// flux at the top, the downwelling diffuse + direct flux at the bottom, 16
+// directions by the midpoint rule in mu^2), here with six channels of
+// optical thickness 1 to 30 carried by the same paths.
+TEST(ReferenceHero, ConservativeSlabConservesEnergyInEveryChannel) {
+    constexpr double kThickness = 1000.0;
+    const double taus[6] = {1.0, 2.0, 5.0, 10.0, 20.0, 30.0};
+    AtmosphereParameters atm = EarthAtmosphere();
+    atm.bottom_radius = 1e9;
+    atm.top_radius = 1e9 + kThickness;
+    atm.rayleigh_scattering = Vec3d(30.0 / kThickness, 10.0 / kThickness, 1.0 / kThickness);
+    atm.rayleigh_density = DensityProfile();
+    atm.rayleigh_density.layers[1].constant_term = 1.0;
+    atm.rayleigh_density.layers[0] = atm.rayleigh_density.layers[1];
+    atm.mie_scattering = atm.mie_extinction = Vec3d(0.0);
+    atm.absorption_extinction = Vec3d(0.0);
+    atm.ground_albedo = Vec3d(0.0);
+    ValidateAtmosphere(atm);
+    ReferenceModel model{ReferenceOptions()};
+    model.Prepare(atm);  // its majorants bound tau 30, the largest
+    ReferenceHero hero;
+    static_cast<ReferenceHybrid&>(hero) = model.evaluator();
+    hero.spec.count = 6;
+    for (int c = 0; c < 6; ++c) hero.spec.rayleigh[c] = taus[c] / kThickness;
+    hero.spec.column_scale = Vec3d(30.0 / kThickness, 0.0, 0.0);
+    constexpr int kDirections = 16, kBatches = 8, kPerBatch = 64;
+    hero.sample_count = kPerBatch;
+    double sum[6] = {}, sum_sq[6] = {};
+    for (int b = 0; b < kBatches; ++b) {
+        hero.sample_begin = static_cast<int64_t>(b) * kPerBatch;
+        double flux[6] = {};
+        for (int i = 0; i < kDirections; ++i) {
+            const double mu = std::sqrt((i + 0.5) / kDirections);
+            const Vec3d sun(0.0, 0.0, 1.0);
+            const Vec3d dir_down(std::sqrt(1.0 - mu * mu), 0.0, mu);
+            const Vec3d dir_up(dir_down.x, 0.0, -mu);
+            double sky[kHeroMaxChannels], ground[kHeroMaxChannels];
+            hero.EvaluateHero(Vec3d(0.0, 0.0, atm.top_radius - 1e-3), dir_up, sun, true, 2 * i + 1,
+                              sky, ground);
+            for (int c = 0; c < 6; ++c) {
+                flux[c] += kPi * (sky[c] + ground[c]) / kPerBatch / kDirections;
+            }
+            hero.EvaluateHero(Vec3d(0.0, 0.0, atm.bottom_radius + 1e-3), dir_down, sun, true,
+                              2 * i + 2, sky, ground);
+            for (int c = 0; c < 6; ++c) {
+                flux[c] += kPi * (sky[c] + ground[c]) / kPerBatch / kDirections;
+            }
+        }
+        for (int c = 0; c < 6; ++c) {
+            flux[c] += std::exp(-taus[c]);  // the direct beam
+            sum[c] += flux[c];
+            sum_sq[c] += flux[c] * flux[c];
+        }
+    }
+    for (int c = 0; c < 6; ++c) {
+        const double mean = sum[c] / kBatches;
+        const double se =
+            std::sqrt(std::max(sum_sq[c] / kBatches - mean * mean, 0.0) / (kBatches - 1.0));
+        EXPECT_NEAR(mean, 1.0, std::max(4.0 * se, 0.02)) << "tau " << taus[c] << ", s.e. " << se;
+    }
+}
 
 TEST(ReferenceHero, SameAnswerOnOneAndTwoThreads) {
     const SpectralAtmosphere atm = LoadSpectralAtmosphere("earth-spectral");
