@@ -43,6 +43,10 @@ struct ModelCapabilities {
     // form of its own (preetham). false: compare/bench skip it in spectral
     // runs and --wavelengths refuses it.
     bool spectral = true;
+    // Monte Carlo models whose paths carry any number of wavelengths at once
+    // (hero-wavelength sampling): a spectral run gives them all its wavelengths
+    // in one set of paths (Model::SetSpectralPaths) instead of batches of three.
+    bool spectral_paths = false;
     // `atmos fit` trains its weights against a reference model.
     bool trainable = false;
     // A baseline that models nothing (`empty`): compare leaves it out of the
@@ -221,6 +225,23 @@ class Model {
     // spectral form of its own (preetham) builds it in the Prepare() that follows.
     virtual void SetSpectralBatch(const SpectralAtmosphere& /*atmosphere*/,
                                   const double /*nm*/[3]) {}
+    // Monte Carlo models whose paths carry any number of wavelengths at once
+    // (ModelCapabilities::spectral_paths: hero-wavelength sampling): a spectral
+    // run (harness/spectral_run.h) gives them all its wavelengths instead of
+    // batches of three. SetSpectralPaths(atmosphere, nm) comes before the one
+    // Prepare() (given the atmosphere at three of the wavelengths); then
+    // RenderSpectralPaths writes the radiance per unit solar irradiance of
+    // every pixel at every wavelength,
+    // (*values)[(y * width + x) * nm.size() + i], from request.monte_carlo's spp
+    // and seed (radiance, no sun disc), and SampleSpectralPaths the radiance per
+    // unit irradiance of each query (sky; plus ground where the query asks),
+    // [q * nm.size() + i], mc.spp paths from mc.seed. Others throw atmos::Error.
+    virtual void SetSpectralPaths(const SpectralAtmosphere& atmosphere,
+                                  const std::vector<double>& nm);
+    virtual void RenderSpectralPaths(const RenderRequest& request,
+                                     std::vector<float>* values) const;
+    virtual std::vector<float> SampleSpectralPaths(const std::vector<SampleQuery>& queries,
+                                                   const MonteCarloSettings& mc) const;
     // Renders the view's radiance (times the view's irradiance and the
     // atmosphere's solar irradiance) or transmittance into `out` (resized).
     virtual void Render(const RenderRequest& request, Image* out) const = 0;

@@ -200,4 +200,17 @@ std::string Model::PassKey() const {
     Fail("model ", Info().name, " is not a Monte Carlo model: it has no pass key");
 }
 
+void Model::SetSpectralPaths(const SpectralAtmosphere&, const std::vector<double>&) {
+    Fail("model ", Info().name, " has no paths that carry many wavelengths");
+}
+
+void Model::RenderSpectralPaths(const RenderRequest&, std::vector<float>*) const {
+    Fail("model ", Info().name, " has no paths that carry many wavelengths");
+}
+
+std::vector<float> Model::SampleSpectralPaths(const std::vector<SampleQuery>&,
+                                              const MonteCarloSettings&) const {
+    Fail("model ", Info().name, " has no paths that carry many wavelengths");
+}
+
 }  // namespace atmos
