@@ -84,6 +84,12 @@ struct ValidityDomain {
     // constituents, largest channel: VerticalOpticalDepth).
     double max_optical_depth = 0.0;
     std::string optical_depth_reason;
+    // A fitted sky (preetham, hosek-wilkie): the atmosphere its coefficients
+    // were fitted to, by name ("earth", a preset or a file). Its sky does not
+    // follow another planet's, so the planet must match
+    // (AtmosphereShapeDifferences). Null: no check.
+    std::string fitted_to;
+    std::shared_ptr<const AtmosphereParameters> fitted_atmosphere;
 };
 
 struct ModelInfo {
@@ -305,6 +311,14 @@ std::vector<std::string> ValidityDomainViolations(const ModelInfo& info,
 // Prints "atmos: warning: model NAME: outside its valid domain: REASON" on
 // stderr for each violation (models call it at the start of Prepare()).
 void WarnOutsideValidityDomain(const ModelInfo& info, const AtmosphereParameters& atmosphere);
+// Where `atmosphere` is another planet than `fit`: its bottom_radius more than
+// 2 % apart, or its air (rayleigh_density) a profile more than 10 % apart, as
+// "FIELD VALUE (fit: VALUE)". Earth's variants (a 60 km shell, no ozone, other
+// aerosols: a fitted sky's turbidity stands for those) are the same planet;
+// the scattering coefficients are not compared (a spectral run's batches
+// change them).
+std::vector<std::string> AtmosphereShapeDifferences(const AtmosphereParameters& atmosphere,
+                                                    const AtmosphereParameters& fit);
 
 // All registered models, in the registry's order (src/atmos/models/registry.cpp).
 std::vector<ModelInfo> ListModels();
