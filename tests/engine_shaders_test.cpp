@@ -3,8 +3,11 @@
 // Every stage compiles here with glslangValidator -V on its own, its SPIR-V passes
 // spirv-val, and every HLSL file compiles back to SPIR-V with glslang's HLSL front
 // end (the round trip). Skipped when Debian's glslang-tools / spirv-cross are absent.
+// A bake's GPU precomputation (its "gpu_precompute" passes: bruneton, hillaire)
+// is one more fragment stage, and every pass also compiles as GLSL 3.30 and ES 3.00.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -12,6 +15,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "io/engine_shaders.h"
 #include "test_util.h"
@@ -43,11 +48,11 @@ TEST(EngineShaders, EveryStageCompilesAndTranslates) {
     const BakeCase cases[] = {
         {"bruneton",
          "bruneton:orders=1:scattering-r=4:scattering-mu=8:scattering-mu-s=4:scattering-nu=2",
-         {"bruneton.vert", "bruneton.frag"}},
+         {"bruneton.vert", "bruneton.frag", "bruneton_precompute.frag"}},
         {"hillaire",
          "hillaire",
          {"hillaire.vert", "hillaire.frag", "hillaire_sky_view.comp",
-          "hillaire_aerial_perspective.comp"}},
+          "hillaire_aerial_perspective.comp", "hillaire_precompute.frag"}},
         {"atmosphere_plus", "atmosphere-plus", {"atmosphere_plus.vert", "atmosphere_plus.frag"}},
         {"hosek_wilkie", "hosek-wilkie", {"hosek_wilkie.vert", "hosek_wilkie.frag"}},
     };
@@ -113,6 +118,15 @@ TEST(EngineShaders, EveryStageCompilesAndTranslates) {
             EXPECT_EQ(RunShellCommand("spirv-val --target-env vulkan1.0 " + back.string(), &out), 0)
                 << hlsl << ": " << out;
             const std::string hlsl_text = Slurp(hlsl);
+            if (stage.find("_precompute.") != std::string::npos) {
+                // Every pass of "gpu_precompute" in one stage, selected by
+                // specialization constant 0 (HLSL: a define; Metal: a function constant).
+                EXPECT_NE(hlsl_text.find("SPIRV_CROSS_CONSTANT_ID_0"), std::string::npos) << hlsl;
+                EXPECT_NE(metal_text.find("[[function_constant(0)]]"), std::string::npos) << metal;
+                EXPECT_NE(text.find("if (ATMOS_PASS == 0) atmos_pass_0();  // ATMOS_"),
+                          std::string::npos)
+                    << source;
+            }
             if (kind != "vert") {  // the full-screen triangle reads no uniform
                 EXPECT_NE(hlsl_text.find("cbuffer AtmosFrame : register(b0)"), std::string::npos)
                     << hlsl;
@@ -126,6 +140,79 @@ TEST(EngineShaders, EveryStageCompilesAndTranslates) {
         EXPECT_EQ(bindings.find("atmos_transmittance_texture") != std::string::npos,
                   std::string(c.model) != "hosek-wilkie")
             << bindings;
+    }
+}
+
+// Issue 35 item 3: every pass of a bake's "gpu_precompute" (bruneton's
+// precomputation, shaders/bruneton_precompute.glsl; hillaire's transmittance and
+// multiple scattering, shaders/hillaire_precompute.glsl) compiles with glslang as
+// GLSL 3.30 core and as GLSL ES 3.00 (WebGL2), in the order the schema gives:
+// the #version line (and the ES precision lines), the pass's "#define ENTRY 1",
+// then the listed files (io/gpu_passes.h). Both storage layouts of the Mie
+// scattering, and orders 3 (15 entries) and 1 (6, ZERO among them): all 16;
+// hillaire's 2.
+TEST(EngineShaders, EveryPrecomputePassCompiles) {
+    if (!Have("glslangValidator")) {
+        GTEST_SKIP() << "glslang-tools not installed (scripts/setup.sh installs them)";
+    }
+    const std::string small = "scattering-r=4:scattering-mu=8:scattering-mu-s=4:scattering-nu=2";
+    const struct {
+        std::string spec, json;
+        size_t entries;
+    } cases[] = {
+        {"bruneton:" + small + ":orders=3:mie-storage=separate", "bruneton.json", 15},
+        {"bruneton:" + small + ":orders=1:mie-storage=combined", "bruneton.json", 6},
+        {"hillaire", "hillaire.json", 2},
+    };
+    for (const auto& c : cases) {
+        const std::string& options = c.spec;
+        const fs::path dir = TempDir() / "gpu_precompute";
+        fs::remove_all(dir);
+        std::string out;
+        ASSERT_EQ(RunShellCommand(std::string(ATMOS_CLI_PATH) + " bake -q --model " + c.spec +
+                                      " -o " + dir.string(),
+                                  &out),
+                  0)
+            << out;
+        const nlohmann::json j = nlohmann::json::parse(Slurp(dir / c.json));
+        ASSERT_TRUE(j.contains("gpu_precompute")) << options;
+        std::string sources;
+        for (const auto& file : j["gpu_precompute"]["shaders"]) {
+            const fs::path path = dir / file.get<std::string>();
+            ASSERT_TRUE(fs::exists(path)) << path;
+            sources += Slurp(path) + "\n";
+        }
+        std::vector<std::string> entries;
+        for (const auto& pass : j["gpu_precompute"]["passes"]) {
+            const std::string entry = pass["entry"];
+            if (std::find(entries.begin(), entries.end(), entry) == entries.end()) {
+                entries.push_back(entry);
+            }
+            // Every input and the target are declared targets.
+            ASSERT_TRUE(j["gpu_precompute"]["targets"].contains(pass["target"].get<std::string>()));
+            for (const auto& [sampler, target] : pass["inputs"].items()) {
+                EXPECT_NE(sources.find(" " + sampler + ";"), std::string::npos) << sampler;
+                EXPECT_TRUE(j["gpu_precompute"]["targets"].contains(target.get<std::string>()));
+            }
+        }
+        EXPECT_EQ(entries.size(), c.entries) << options;
+        for (const std::string& entry : entries) {
+            for (const std::string version : {std::string("330 core"), std::string("300 es")}) {
+                const std::string precision = version == "300 es"
+                                                  ? "precision highp float;\nprecision highp "
+                                                    "int;\nprecision highp sampler3D;\n"
+                                                  : "";
+                const fs::path frag = TempDir() / "pass.frag";
+                {
+                    std::ofstream f(frag);
+                    f << "#version " << version << "\n"
+                      << precision << "#define " << entry << " 1\n"
+                      << sources;
+                }
+                EXPECT_EQ(RunShellCommand("glslangValidator " + frag.string(), &out), 0)
+                    << entry << " (" << version << ", " << options << "): " << out;
+            }
+        }
     }
 }
 

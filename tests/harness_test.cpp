@@ -475,6 +475,26 @@ TEST(ShippedReferences, FingerprintIdentifiesTheRender) {
     EXPECT_NE(HashText(ViewFingerprintText(moved)), a.view_hashes.at("ground-noon"));
 }
 
+// The shipped references (data/references/*) are fingerprinted with the
+// default reference's resolved options: a new option of the reference (or a
+// changed default) must be recorded there, else `compare` silently re-renders
+// every reference ("reference model options differ").
+TEST(ShippedReferences, FingerprintsNameTheDefaultReference) {
+    const AtmosphereParameters earth = LoadAtmosphere("earth", {});
+    const ReferenceFingerprint run =
+        MakeReferenceFingerprint("reference", {}, "earth", earth, 16, 9, {});
+    int count = 0;
+    for (const auto& entry :
+         fs::directory_iterator(fs::path(ATMOS_SOURCE_DIR) / "data" / "references")) {
+        if (!fs::exists(entry.path() / "provenance.json")) continue;
+        const ShippedReferences shipped = ReadShippedReferences(entry.path().string());
+        EXPECT_EQ(shipped.fingerprint.model, run.model) << entry.path();
+        EXPECT_EQ(shipped.fingerprint.estimator_version, run.estimator_version) << entry.path();
+        ++count;
+    }
+    EXPECT_GE(count, 2);
+}
+
 // The noise rule: a shipped image is used when its noise is at or below the
 // target, or it has at least the run's paths per pixel (cap or fixed count).
 TEST(ShippedReferences, UsedWhenAtLeastAsGoodAsTheRunsRender) {

@@ -198,8 +198,8 @@ TEST(Spectral, BatchSeedsCorrelateOrSeparateTheBatches) {
     double gap[2] = {0.0, 0.0};
     for (const BatchSeeds seeds : {BatchSeeds::kSame, BatchSeeds::kDistinct}) {
         const std::vector<double> v =
-            SampleSpectral(ParseModelSpec("reference"), a, nm, queries, mc, prepare,
-                           SpectralBatching{seeds, BatchLayout::kConsecutive});
+            SampleSpectral(ParseModelSpec("reference:spectral=batches"), a, nm, queries, mc,
+                           prepare, SpectralBatching{seeds, BatchLayout::kConsecutive});
         double sum = 0.0, mean = 0.0;
         for (size_t q = 0; q < queries.size(); ++q) {
             sum += std::abs(v[q * 6 + 3] - v[q * 6 + 2]);

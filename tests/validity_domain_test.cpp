@@ -5,9 +5,13 @@
 // every model that produces transmittance either warns (or refuses) or gives
 // the analytic zenith transmittance.
 #include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "atmos/error.h"
 #include "atmos/model.h"
+#include "models/hosek_wilkie_coefficients.h"
+#include "test_util.h"
 
 namespace atmos {
 namespace {
@@ -141,6 +145,54 @@ TEST(ValidityDomain, ThickPresetsWarnInEveryMultipleScatteringModel) {
         }
         EXPECT_GE(checked, 3) << preset;  // bruneton, hillaire, atmosphere-plus at least
     }
+}
+
+// A fitted sky (preetham, hosek-wilkie) answers Earth's sky whatever the
+// atmosphere: on another planet Prepare() warns, naming the fit's atmosphere
+// and the first field that differs (it used to say nothing). A coefficient
+// file from `atmos fit` is checked against the atmosphere it records: fitted
+// to mars, it warns on earth and not on mars.
+std::string PrepareWarning(Model& model, const AtmosphereParameters& atmosphere) {
+    ::testing::internal::CaptureStderr();
+    model.Prepare(atmosphere);
+    return ::testing::internal::GetCapturedStderr();
+}
+
+TEST(ValidityDomain, FittedSkiesWarnOnAnotherPlanet) {
+    int fitted = 0;
+    for (const ModelInfo& info : ListModels()) {
+        if (!info.domain.fitted_atmosphere) continue;
+        ++fitted;
+        std::unique_ptr<Model> model = CreateModel(info.name);
+        for (const char* preset : {"mars", "titan", "venus"}) {
+            const std::string err = PrepareWarning(*model, LoadAtmosphere(preset));
+            EXPECT_NE(err.find("fit to the atmosphere 'earth'"), std::string::npos)
+                << info.name << " on " << preset << ": " << err;
+            EXPECT_NE(err.find("bottom_radius"), std::string::npos) << err;
+        }
+        EXPECT_EQ(PrepareWarning(*model, EarthAtmosphere()), "") << info.name;
+    }
+    EXPECT_EQ(fitted, 2);  // preetham, hosek-wilkie
+
+    HosekWilkieCoefficients c;
+    for (int ch = 0; ch < 3; ++ch) {
+        for (int i = 0; i < 6; ++i) {
+            for (int p = 0; p < 10; ++p) c.ctrl[ch][i][p] = 0.1 * (p + 1);
+        }
+    }
+    c.reference = "bruneton";
+    c.atmosphere = "mars";
+    const AtmosphereParameters mars = LoadAtmosphere("mars");
+    nlohmann::ordered_json fit;
+    fit["atmosphere_parameters"] = nlohmann::ordered_json::parse(AtmosphereToJson(mars));
+    c.fit_json = fit.dump();
+    const std::string path =
+        (atmos_test::FreshTestTmpDir("fitted_domain") / "hw-mars.json").string();
+    std::ofstream(path) << HosekWilkieCoefficientsToJson(c);
+    std::unique_ptr<Model> hw = CreateModel("hosek-wilkie", {{"coefficients", path}});
+    EXPECT_EQ(PrepareWarning(*hw, mars), "");
+    const std::string err = PrepareWarning(*hw, EarthAtmosphere());
+    EXPECT_NE(err.find("fit to the atmosphere 'mars'"), std::string::npos) << err;
 }
 
 // The Earth presets the figures and tables use are inside every domain (no

@@ -199,16 +199,17 @@ function compile(gl, type, source) {
   return s;
 }
 
+var GLSL_HEADER = '#version 300 es\nprecision highp float;\nprecision highp sampler2D;\n' +
+                  'precision highp sampler3D;\n';
+
 // One model: its program (GLSL ES header + the bake's constants + common.glsl
-// and the model's functions + MAIN_SHADER) and its textures.
+// and the model's functions + MAIN_SHADER) and its textures. The baked
+// tables' textures stay in model.bakedTextures; a GPU precomputation
+// (runPrecompute) puts its targets in their units of model.textures.
 function makeModel(gl, name, format, blob) {
   var data = atmosViewerData.models[name];
   // A model without tables (hosek-wilkie: constants only) has an empty blob.
   if (!data || blob === undefined) throw new Error('no baked data for model ' + name);
-  var fragment = '#version 300 es\nprecision highp float;\nprecision highp sampler2D;\n' +
-                 'precision highp sampler3D;\n' + data.constants + '\n' + data.functions +
-                 '\n' + MAIN_SHADER;
-  var program = linkProgram(gl, fragment);
   var raw = data.bake.raw.tables;
   // Texture units: the sampler names of the model's GLSL file.
   var samplers = {
@@ -221,19 +222,34 @@ function makeModel(gl, name, format, blob) {
     'atmosphere-plus': [['atmos_scattering_texture', 'scattering'],
                         ['atmos_transmittance_texture', 'transmittance']],
     'hosek-wilkie': []}[name];
-  var textures = [];
-  gl.useProgram(program);
+  var atm = data.bake.atmosphere;
+  var model = {name: name, data: data, textures: [], units: [], tableUnit: {},
+               bottom: atm.bottom_radius, top: atm.top_radius};
   samplers.forEach(function (s) {
     if (!raw[s[1]]) return;
-    var t = makeTexture(gl, blob, format, raw[s[1]]);
-    gl.uniform1i(gl.getUniformLocation(program, s[0]), textures.length);
-    textures.push(t);
+    model.tableUnit[s[1]] = model.textures.length;
+    model.units.push([s[0], model.textures.length]);
+    model.textures.push(makeTexture(gl, blob, format, raw[s[1]]));
   });
-  var atm = data.bake.atmosphere;
-  var model = {name: name, program: program, textures: textures,
-               bottom: atm.bottom_radius, top: atm.top_radius};
-  if (name === 'hillaire') makeHillaireFrame(gl, model, fragment.replace(MAIN_SHADER, ''));
+  model.bakedTextures = model.textures.slice();
+  // The per-frame passes, for a shader that defines them (asked of the
+  // shader, as src/atmos/io/engine_shaders.h does).
+  if (data.functions.indexOf('atmos_SkyViewTexel') >= 0) makeHillaireFrame(gl, model);
+  linkModel(gl, model, data.constants);
   return model;
+}
+
+// (Re)links the model's programs over the constants `constants` (the bake's,
+// or those of another atmosphere: atmosphereConstants).
+function linkModel(gl, model, constants) {
+  var base = GLSL_HEADER + constants + '\n' + model.data.functions + '\n';
+  model.program = linkProgram(gl, base + MAIN_SHADER);
+  gl.useProgram(model.program);
+  model.units.forEach(function (u) {
+    gl.uniform1i(gl.getUniformLocation(model.program, u[0]), u[1]);
+  });
+  if (model.hillaire) linkHillaireFrame(gl, model, base);
+  model.constants = constants;
 }
 
 // Hillaire's per-frame tables (hillaire.glsl, passes 1 and 2): the sky-view
@@ -302,27 +318,32 @@ function makeTarget(gl, target, w, h, d) {
   return {texture: tex, target: target};
 }
 
-function makeHillaireFrame(gl, model, base) {
+function makeHillaireFrame(gl, model) {
   if (!gl.getExtension('EXT_color_buffer_float')) {
     throw new Error('hillaire needs EXT_color_buffer_float (float render targets)');
   }
   var sky = makeTarget(gl, gl.TEXTURE_2D, 192, 108, 1);
   var apS = makeTarget(gl, gl.TEXTURE_3D, 32, 32, 32);
   var apT = makeTarget(gl, gl.TEXTURE_3D, 32, 32, 32);
-  var units = [['atmos_sky_view_texture', sky], ['atmos_ap_scatter_texture', apS],
-               ['atmos_ap_transmittance_texture', apT]];
-  gl.useProgram(model.program);
-  units.forEach(function (u) {
-    gl.uniform1i(gl.getUniformLocation(model.program, u[0]), model.textures.length);
+  [['atmos_sky_view_texture', sky], ['atmos_ap_scatter_texture', apS],
+   ['atmos_ap_transmittance_texture', apT]].forEach(function (u) {
+    model.units.push([u[0], model.textures.length]);
     model.textures.push(u[1]);
   });
   // Ping-pong copies of one slice's L and T for the next slice.
   var state = [0, 1].map(function () {
     return [makeTarget(gl, gl.TEXTURE_2D, 32, 32, 1), makeTarget(gl, gl.TEXTURE_2D, 32, 32, 1)];
   });
-  var passes = {sky: linkProgram(gl, base + SKY_VIEW_MAIN), ap: linkProgram(gl, base + AP_MAIN),
-                skyTarget: sky, apScatter: apS, apTransmittance: apT, apState: state,
-                skyFb: gl.createFramebuffer(), apFb: gl.createFramebuffer()};
+  model.hillaire = {skyTarget: sky, apScatter: apS, apTransmittance: apT, apState: state,
+                    skyFb: gl.createFramebuffer(), apFb: gl.createFramebuffer()};
+  gl.bindFramebuffer(gl.FRAMEBUFFER, model.hillaire.skyFb);
+  gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, sky.texture, 0);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+}
+function linkHillaireFrame(gl, model, base) {
+  var passes = model.hillaire;
+  passes.sky = linkProgram(gl, base + SKY_VIEW_MAIN);
+  passes.ap = linkProgram(gl, base + AP_MAIN);
   [passes.sky, passes.ap].forEach(function (p) {
     gl.useProgram(p);
     gl.uniform1i(gl.getUniformLocation(p, 'atmos_transmittance_texture'), 0);
@@ -330,9 +351,6 @@ function makeHillaireFrame(gl, model, base) {
   });
   gl.uniform1i(gl.getUniformLocation(passes.ap, 'u_prev_scatter'), 2);
   gl.uniform1i(gl.getUniformLocation(passes.ap, 'u_prev_transmittance'), 3);
-  gl.bindFramebuffer(gl.FRAMEBUFFER, passes.skyFb);
-  gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, sky.texture, 0);
-  model.hillaire = passes;
 }
 
 // The frame camera of Hillaire's aerial-perspective volume (atmos_ap_*).
@@ -427,11 +445,261 @@ function drawView(gl, model, view, width, height, opts, x0, x1, target) {
   gl.disable(gl.SCISSOR_TEST);
 }
 
+// ---- a bake's tables computed on the GPU (its JSON's "gpu_precompute") ----
+// The schema is src/atmos/io/gpu_passes.h; any model whose bake lists passes
+// runs here (the page asks the bake, never the model's name). Each pass: one
+// full-screen triangle per layer of its target (uniform int atmos_layer),
+// into float render targets (EXT_color_buffer_float), inputs sampled LINEAR
+// and CLAMP_TO_EDGE; "add" passes blend ONE, ONE where float blending exists
+// (EXT_float_blend for RGBA32F) and otherwise copy the layer, render into a
+// scratch texture and add the two (?blend=copy forces that path).
+var ADD_SHADER = [
+  'uniform highp sampler2D u_old;',
+  'uniform highp sampler2D u_new;',
+  'out vec4 atmos_out;',
+  'void main() {',
+  '  ivec2 p = ivec2(gl_FragCoord.xy);',
+  '  atmos_out = texelFetch(u_old, p, 0) + texelFetch(u_new, p, 0);',
+  '}'].join('\n');
+
+function hasPrecompute(model) { return !!model.data.bake.gpu_precompute; }
+
+function makePrecompute(gl, model) {
+  if (!gl.getExtension('EXT_color_buffer_float')) {
+    throw new Error('the GPU precomputation needs EXT_color_buffer_float (float render targets)');
+  }
+  var spec = model.data.bake.gpu_precompute;
+  var pc = {spec: spec, targets: {}, fb: gl.createFramebuffer(), scratch: {}};
+  Object.keys(spec.targets).forEach(function (name) {
+    var t = spec.targets[name];
+    var tex = makeTarget(gl, t.depth > 1 ? gl.TEXTURE_3D : gl.TEXTURE_2D, t.width, t.height,
+                         t.depth);
+    pc.targets[name] = {width: t.width, height: t.height, depth: t.depth, tex: tex};
+  });
+  pc.internal = gl.getExtension('OES_texture_float_linear') ? gl.RGBA32F : gl.RGBA16F;
+  pc.blend = atmosViewerParams.get('blend') !== 'copy' &&
+             (pc.internal === gl.RGBA16F || !!gl.getExtension('EXT_float_blend'));
+  if (!pc.blend) pc.addProgram = linkProgram(gl, GLSL_HEADER + ADD_SHADER);
+  model.precompute = pc;
+}
+
+// The passes' programs over `constants` (the constants file of the bake's
+// shader list replaced by them).
+function linkPrecompute(gl, model, constants) {
+  var pc = model.precompute, data = model.data;
+  var body = pc.spec.shaders.map(function (path) {
+    if (path === data.constantsPath) return constants;
+    if (data.sources[path] === undefined) throw new Error('no shader ' + path + ' in model.js');
+    return data.sources[path];
+  }).join('\n');
+  pc.programs = pc.spec.passes.map(function (pass) {
+    // The schema's header: #version, the precision lines (int too), the entry.
+    var program = linkProgram(gl, GLSL_HEADER + 'precision highp int;\n#define ' + pass.entry +
+                                      ' 1\n' + body);
+    gl.useProgram(program);
+    Object.keys(pass.inputs).forEach(function (sampler, unit) {
+      gl.uniform1i(gl.getUniformLocation(program, sampler), unit);
+    });
+    Object.keys(pass.uniforms).forEach(function (name) {
+      gl.uniform1i(gl.getUniformLocation(program, name), pass.uniforms[name]);
+    });
+    return program;
+  });
+}
+
+function attachLayer(gl, tex, z) {
+  if (tex.target === gl.TEXTURE_3D) {
+    gl.framebufferTextureLayer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, tex.texture, 0, z);
+  } else {
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex.texture, 0);
+  }
+}
+function scratchTexture(gl, pc, key, w, h) {
+  var k = key + w + 'x' + h;
+  if (!pc.scratch[k]) pc.scratch[k] = makeTarget(gl, gl.TEXTURE_2D, w, h, 1);
+  return pc.scratch[k];
+}
+
+// Runs the passes (programs from linkPrecompute); the table targets then
+// replace the baked textures of their units.
+function runPrecompute(gl, model) {
+  var pc = model.precompute;
+  gl.disable(gl.SCISSOR_TEST);
+  gl.disable(gl.BLEND);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, pc.fb);
+  gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
+  pc.spec.passes.forEach(function (pass, i) {
+    var program = pc.programs[i], out = pc.targets[pass.target];
+    var bindInputs = function () {
+      gl.useProgram(program);
+      Object.keys(pass.inputs).forEach(function (sampler, unit) {
+        var t = pc.targets[pass.inputs[sampler]].tex;
+        gl.activeTexture(gl.TEXTURE0 + unit);
+        gl.bindTexture(t.target, t.texture);
+      });
+    };
+    bindInputs();
+    var layer = gl.getUniformLocation(program, 'atmos_layer');
+    gl.viewport(0, 0, out.width, out.height);
+    for (var z = 0; z < out.depth; ++z) {
+      if (layer) gl.uniform1i(layer, z);
+      if (pass.blend !== 'add') {
+        attachLayer(gl, out.tex, z);
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+      } else if (pc.blend) {
+        attachLayer(gl, out.tex, z);
+        gl.enable(gl.BLEND);
+        gl.blendEquation(gl.FUNC_ADD);
+        gl.blendFunc(gl.ONE, gl.ONE);
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+        gl.disable(gl.BLEND);
+      } else {
+        // Copy and add: old layer -> A, the pass -> B, then A + B -> the layer.
+        var a = scratchTexture(gl, pc, 'old', out.width, out.height);
+        var b = scratchTexture(gl, pc, 'new', out.width, out.height);
+        attachLayer(gl, out.tex, z);
+        gl.activeTexture(gl.TEXTURE0);
+        gl.bindTexture(gl.TEXTURE_2D, a.texture);
+        gl.copyTexSubImage2D(gl.TEXTURE_2D, 0, 0, 0, 0, 0, out.width, out.height);
+        bindInputs();
+        attachLayer(gl, b, 0);
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+        attachLayer(gl, out.tex, z);
+        gl.useProgram(pc.addProgram);
+        gl.activeTexture(gl.TEXTURE0);
+        gl.bindTexture(gl.TEXTURE_2D, a.texture);
+        gl.activeTexture(gl.TEXTURE1);
+        gl.bindTexture(gl.TEXTURE_2D, b.texture);
+        gl.uniform1i(gl.getUniformLocation(pc.addProgram, 'u_old'), 0);
+        gl.uniform1i(gl.getUniformLocation(pc.addProgram, 'u_new'), 1);
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+        bindInputs();
+      }
+    }
+  });
+  Object.keys(pc.targets).forEach(function (name) {
+    if (model.tableUnit[name] !== undefined) {
+      model.textures[model.tableUnit[name]] = pc.targets[name].tex;
+    }
+  });
+  pc.last = pc.targets[pc.spec.passes[pc.spec.passes.length - 1].target];
+}
+
+// Waits for the passes (timeDraw's sync): a one-texel read of the last target.
+function syncPrecompute(gl, model) {
+  var pc = model.precompute;
+  gl.bindFramebuffer(gl.FRAMEBUFFER, pc.fb);
+  attachLayer(gl, pc.last.tex, 0);
+  gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.FLOAT, new Float32Array(4));
+}
+
+// Reads table target `name` back: its first `channels` per texel, layers in
+// order (the layout of the raw blobs, src/atmos/io/raw_tables.h).
+function readTarget(gl, model, name, channels) {
+  var pc = model.precompute, t = pc.targets[name];
+  var texels = t.width * t.height;
+  var rgba = new Float32Array(texels * 4);
+  var out = new Float32Array(texels * t.depth * channels);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, pc.fb);
+  for (var z = 0; z < t.depth; ++z) {
+    attachLayer(gl, t.tex, z);
+    gl.readPixels(0, 0, t.width, t.height, gl.RGBA, gl.FLOAT, rgba);
+    for (var i = 0; i < texels; ++i) {
+      for (var c = 0; c < channels; ++c) out[(z * texels + i) * channels + c] = rgba[4 * i + c];
+    }
+  }
+  return out;
+}
+
+// ---- the atmosphere: as baked, or a preset (presets.js), with scales ----
+// The sliders scale the Rayleigh scattering (ray), the Mie scattering and
+// extinction (mie) and the ozone absorption (oz); alb sets a grey ground
+// albedo (-1: the atmosphere's own). The #defines of the atmosphere's
+// constants are rewritten (9 digits, as the bake writes them) and the
+// model's own #defines follow (model.js modelConstants).
+var SCALED_DEFINES = {ATMOS_RAYLEIGH_SCATTERING: 'ray', ATMOS_MIE_SCATTERING: 'mie',
+                      ATMOS_MIE_EXTINCTION: 'mie', ATMOS_ABSORPTION_EXTINCTION: 'oz'};
+function isBakedAtmosphere(s) {
+  return !s.atm && s.ray === 1 && s.mie === 1 && s.oz === 1 && s.alb < 0;
+}
+function fmtGlsl(x) { return x.toExponential(9); }
+// {constants (the atmosphere's #defines), bottom, top, albedo} of the state's
+// atmosphere for a model (its baked one unless s.atm names a preset).
+function stateAtmosphere(s, model) {
+  var preset = s.atm && window.atmosViewerPresets ? atmosViewerPresets[s.atm] : null;
+  var text, bottom, top;
+  if (preset) {
+    text = preset.constants;
+    bottom = preset.bottom;
+    top = preset.top;
+  } else {
+    var c = model.data.constants;
+    text = c.slice(0, c.length - model.data.modelConstants.length);
+    bottom = model.data.bake.atmosphere.bottom_radius;
+    top = model.data.bake.atmosphere.top_radius;
+  }
+  var lines = text.split('\n').map(function (line) {
+    var m = /^#define (ATMOS_[A-Z_]+) vec3\(([^,]+), ([^,]+), ([^)]+)\)$/.exec(line);
+    if (!m) return line;
+    var v = [parseFloat(m[2]), parseFloat(m[3]), parseFloat(m[4])];
+    if (SCALED_DEFINES[m[1]]) {
+      var k = s[SCALED_DEFINES[m[1]]];
+      if (k === 1) return line;
+      v = v.map(function (x) { return x * k; });
+    } else if (m[1] === 'ATMOS_GROUND_ALBEDO' && s.alb >= 0) {
+      v = [s.alb, s.alb, s.alb];
+    } else {
+      return line;
+    }
+    return '#define ' + m[1] + ' vec3(' + v.map(fmtGlsl).join(', ') + ')';
+  });
+  return {constants: lines.join('\n'), bottom: bottom, top: top};
+}
+// Gives `model` the state's atmosphere: for a bake with GPU passes, the
+// constants rewritten, the programs relinked and the tables computed on the
+// GPU (timed: done(ms, label)); back to the baked tables and constants for
+// the baked atmosphere. A bake without passes keeps its atmosphere (false).
+function applyAtmosphere(gl, model, s, timer, done, forceGpu) {
+  if (!hasPrecompute(model)) return false;
+  var a = stateAtmosphere(s, model);
+  var constants = a.constants + model.data.modelConstants;
+  if (!forceGpu && isBakedAtmosphere(s)) {
+    if (model.constants !== model.data.constants) linkModel(gl, model, model.data.constants);
+    model.textures = model.textures.map(function (t, i) {
+      return i < model.bakedTextures.length ? model.bakedTextures[i] : t;
+    });
+    model.bottom = a.bottom;
+    model.top = a.top;
+    model.gpuTables = false;
+    if (done) done(NaN);
+    return true;
+  }
+  if (!model.precompute) makePrecompute(gl, model);
+  if (model.constants !== constants || !model.gpuTables) {
+    linkModel(gl, model, constants);
+    linkPrecompute(gl, model, constants);
+  }
+  model.bottom = a.bottom;
+  model.top = a.top;
+  model.gpuTables = true;
+  timeDraw(gl, timer, function () { runPrecompute(gl, model); }, function (ms) {
+    if (done) done(ms);
+  }, function () { syncPrecompute(gl, model); });
+  return true;
+}
+
 // ---- test mode: every view of every model into float images in the DOM ----
+// ?test=1: the views from the baked tables (data-tables="baked"). With
+// &tables=gpu, then every model whose bake has GPU passes computes its tables
+// on the GPU for the atmosphere of the hash's state (the baked one by
+// default), puts each table in the DOM (<pre class="atmos-table">: its raw
+// layout as float32, base64) and renders the views again from them
+// (data-tables="gpu").
 function runTests(gl, format, blobs) {
   var out = document.getElementById('atmos-test');
   var size = (atmosViewerParams.get('size') || '320x180').split('x');
   var width = parseInt(size[0], 10), height = parseInt(size[1], 10);
+  var gpu = atmosViewerParams.get('tables') === 'gpu';
   if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('no EXT_color_buffer_float');
   var fb = gl.createFramebuffer();
   var rb = gl.createRenderbuffer();
@@ -442,13 +710,14 @@ function runTests(gl, format, blobs) {
   var pixels = new Float32Array(width * height * 4);
   var rgb = new Float32Array(width * height * 3);
   var html = [];
-  atmosViewerModels.forEach(function (name) {
-    var model = makeModel(gl, name, format, blobs[name]);
+  var state = parseState(window.location.hash);
+  var timer = makeTimer(gl, 'finish');
+  function renderViews(name, model, tables) {
     var views = standardViews(model.bottom, model.top);
     // With a state in the hash, its view too (named "state"; a free camera
     // is `atmos render --camera --sun`'s, irradiance 1).
     if (window.location.hash) {
-      var v = stateView(parseState(window.location.hash), views, model.bottom);
+      var v = stateView(state, views, model.bottom);
       views.push({name: 'state', camera: v.camera, sun: v.sun, irradiance: v.irradiance});
     }
     views.forEach(function (view) {
@@ -467,9 +736,29 @@ function runTests(gl, format, blobs) {
         }
       }
       html.push('<pre class="atmos-image" data-model="' + name + '" data-view="' + view.name +
-                '" data-width="' + width + '" data-height="' + height + '" data-ms="' +
-                ms.toFixed(1) + '">' + encodeBase64(rgb.buffer) + '</pre>');
+                '" data-tables="' + tables + '" data-width="' + width + '" data-height="' +
+                height + '" data-ms="' + ms.toFixed(1) + '">' + encodeBase64(rgb.buffer) +
+                '</pre>');
     });
+  }
+  atmosViewerModels.forEach(function (name) {
+    var model = makeModel(gl, name, format, blobs[name]);
+    // The baked tables' views (and, with tables=gpu, the baked atmosphere's).
+    renderViews(name, model, 'baked');
+    if (!gpu || !hasPrecompute(model)) return;
+    var ms = NaN;
+    applyAtmosphere(gl, model, state, timer, function (t) { ms = t; }, true);
+    var raw = model.data.bake.raw.tables;
+    Object.keys(model.precompute.targets).forEach(function (t) {
+      if (!raw[t]) return;  // a scratch target
+      var e = raw[t];
+      var values = readTarget(gl, model, t, e.channels);
+      html.push('<pre class="atmos-table" data-model="' + name + '" data-table="' + t +
+                '" data-width="' + e.width + '" data-height="' + e.height + '" data-depth="' +
+                e.depth + '" data-channels="' + e.channels + '" data-ms="' + ms.toFixed(1) +
+                '">' + encodeBase64(values.buffer) + '</pre>');
+    });
+    renderViews(name, model, 'gpu');
   });
   out.innerHTML = html.join('\n');
   out.setAttribute('data-status', 'ok');
@@ -483,12 +772,18 @@ function runTests(gl, format, blobs) {
 // (sun disc 0|1). The free camera and sun are `atmos render --camera
 // altitude=..,azimuth=..,elevation=..,fov=.. --sun elevation=..,azimuth=..`'s
 // (src/atmos/harness/camera_spec.cpp), with its unit sun irradiance.
+// The atmosphere (models whose bake has GPU passes recompute their tables
+// for it): atm (an embedded preset, presets.js, or empty: as baked), ray, mie,
+// oz (scales of the Rayleigh scattering, the Mie scattering and extinction,
+// the ozone absorption; 0..10), alb (grey ground albedo 0..1, -1: the
+// atmosphere's own).
 var STATE_KEYS = ['m', 'm2', 'split', 'pos', 'view', 'alt', 'az', 'el', 'fov', 'sun_az', 'sun_el',
-                  'exp', 'disc'];
+                  'exp', 'disc', 'atm', 'ray', 'mie', 'oz', 'alb'];
 function defaultState() {
   var m = atmosViewerModels;
   return {m: m[0], m2: m.length > 1 ? m[1] : m[0], split: 0, pos: 0.5, view: '', alt: 0, az: 90,
-          el: 10, fov: 60, sun_az: 90, sun_el: 6, exp: 2.6, disc: 1};
+          el: 10, fov: 60, sun_az: 90, sun_el: 6, exp: 2.6, disc: 1, atm: '', ray: 1, mie: 1,
+          oz: 1, alb: -1};
 }
 function clampNum(x, lo, hi, fallback) {
   x = parseFloat(x);
@@ -513,13 +808,23 @@ function parseState(text) {
   s.sun_el = clampNum(p.get('sun_el'), -90, 90, s.sun_el);
   s.exp = clampNum(p.get('exp'), -4, 8, s.exp);
   if (p.has('disc')) s.disc = p.get('disc') === '0' ? 0 : 1;
+  var presets = window.atmosViewerPresets || {};
+  if (p.has('atm') && Object.prototype.hasOwnProperty.call(presets, p.get('atm'))) {
+    s.atm = p.get('atm');
+  }
+  s.ray = clampNum(p.get('ray'), 0, 10, s.ray);
+  s.mie = clampNum(p.get('mie'), 0, 10, s.mie);
+  s.oz = clampNum(p.get('oz'), 0, 10, s.oz);
+  s.alb = clampNum(p.get('alb'), -1, 1, s.alb);
+  if (s.alb < 0) s.alb = -1;
   return s;
 }
 function formatState(s) {
   var v = {m: s.m, m2: s.m2, split: s.split ? 1 : 0, pos: fmtNum(s.pos, 3), view: s.view,
            alt: fmtNum(s.alt, 1), az: fmtNum(s.az, 2), el: fmtNum(s.el, 2), fov: fmtNum(s.fov, 2),
            sun_az: fmtNum(s.sun_az, 2), sun_el: fmtNum(s.sun_el, 2), exp: fmtNum(s.exp, 2),
-           disc: s.disc ? 1 : 0};
+           disc: s.disc ? 1 : 0, atm: s.atm, ray: fmtNum(s.ray, 3), mie: fmtNum(s.mie, 3),
+           oz: fmtNum(s.oz, 3), alb: fmtNum(s.alb, 3)};
   return STATE_KEYS.map(function (k) {
     return k + '=' + encodeURIComponent(String(v[k]));
   }).join('&');
@@ -560,9 +865,27 @@ function stateFromView(s, v, R, keepExposure) {
   // The same picture at the free view's irradiance 1: exposure x 6.
   if (!keepExposure) s.exp = Math.log2(v.exposure * 6);
 }
+// The flags of `atmos render` for the state's atmosphere: --atmosphere PRESET
+// and a --set per changed field, with the values the page's constants hold.
+var SET_FIELDS = {ATMOS_RAYLEIGH_SCATTERING: 'rayleigh_scattering',
+                  ATMOS_MIE_SCATTERING: 'mie_scattering', ATMOS_MIE_EXTINCTION: 'mie_extinction',
+                  ATMOS_ABSORPTION_EXTINCTION: 'absorption_extinction'};
+function atmosphereFlags(s, model) {
+  if (!model || !hasPrecompute(model) || isBakedAtmosphere(s)) return '';
+  var flags = s.atm ? ' --atmosphere ' + s.atm : '';
+  stateAtmosphere(s, model).constants.split('\n').forEach(function (line) {
+    var m = /^#define (ATMOS_[A-Z_]+) vec3\(([^,]+), ([^,]+), ([^)]+)\)$/.exec(line);
+    if (!m || !SET_FIELDS[m[1]] || s[SCALED_DEFINES[m[1]]] === 1) return;
+    flags += ' --set ' + SET_FIELDS[m[1]] + '=' + [m[2], m[3], m[4]].map(function (x) {
+      return String(parseFloat(x));
+    }).join(',');
+  });
+  if (s.alb >= 0) flags += ' --set ground_albedo=' + fmtNum(s.alb, 3);
+  return flags;
+}
 // `atmos render` of the left model's view (the page's pixels, PNG output).
-function renderCommand(s, W, H) {
-  var cmd = 'atmos render --model ' + s.m + ' ';
+function renderCommand(s, W, H, model) {
+  var cmd = 'atmos render --model ' + s.m + atmosphereFlags(s, model) + ' ';
   if (s.view) {
     cmd += '--view ' + s.view;
   } else {
@@ -584,14 +907,18 @@ function makeTimer(gl, force) {
 // from later tasks) or, without the extension, by performance.now() around
 // draw(), gl.finish() and a one-pixel readPixels (the CPU waits for the GPU;
 // includes the browser's and driver's overhead), done(ms) at once.
-function timeDraw(gl, timer, draw, done) {
+// `sync` (optional): the one-pixel read for draws into float targets.
+function timeDraw(gl, timer, draw, done, sync) {
+  var read = sync || function () {
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, timer.pixel);
+  };
   if (!timer.ext) {
     var t0 = performance.now();
     draw();
     gl.finish();
     // finish() need not wait in a browser (Chromium's returns at once): a
     // one-pixel read of the drawn framebuffer does.
-    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, timer.pixel);
+    read();
     done(performance.now() - t0);
     return;
   }
@@ -601,7 +928,7 @@ function timeDraw(gl, timer, draw, done) {
   gl.endQuery(timer.ext.TIME_ELAPSED_EXT);
   // Wait for the draw (the query times the GPU only): the result is then
   // ready at the next task (WebGL makes it available no sooner).
-  gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, timer.pixel);
+  read();
   var poll = function () {
     if (!gl.getQueryParameter(q, gl.QUERY_RESULT_AVAILABLE)) { setTimeout(poll, 1); return; }
     var disjoint = gl.getParameter(timer.ext.GPU_DISJOINT_EXT);
@@ -619,6 +946,7 @@ function median(xs) {
 }
 
 // ---- benchmark mode (?bench=N[&size=WxH][&timer=finish]) ----
+// (The frames come first, then each GPU precomputation; see nextPrecompute.)
 // Per model, one frame of the state's view at WxH (default 1920x1080) into an
 // RGBA8 framebuffer as the page shows it (hillaire's sky-view and
 // aerial-perspective passes included), once to warm up (shader compiles) and
@@ -646,10 +974,40 @@ function runBench(gl, models, state, views, done) {
   console.log(lines[0]);
   var names = atmosViewerModels.slice();
   var opts = {raw: false, sunDisc: !!state.disc, exposure: Math.pow(2, state.exp)};
-  function nextModel() {
-    if (names.length === 0) {
+  // Then each model whose bake lists GPU passes: its precomputation for the
+  // state's atmosphere, once to warm up (it links the programs) and N times:
+  //   atmos-bench-precompute model=NAME runs=N median_ms=X min_ms=Y timer=...
+  var precompute = atmosViewerModels.filter(function (n) { return hasPrecompute(models[n]); });
+  function nextPrecompute() {
+    if (precompute.length === 0) {
       out.setAttribute('data-status', 'done');
       if (done) done();
+      return;
+    }
+    var name = precompute.shift(), model = models[name];
+    var times = [], left = runs;
+    var draw = function () { runPrecompute(gl, model); };
+    var sync = function () { syncPrecompute(gl, model); };
+    applyAtmosphere(gl, model, state, timer, function () {
+      var again = function () {
+        timeDraw(gl, timer, draw, function (ms) {
+          times.push(ms);
+          if (--left > 0) { again(); return; }
+          var line = 'atmos-bench-precompute model=' + name + ' runs=' + runs + ' median_ms=' +
+                     median(times).toFixed(3) + ' min_ms=' +
+                     Math.min.apply(null, times).toFixed(3) + ' timer=' + timer.label;
+          lines.push(line);
+          console.log(line);
+          out.textContent = lines.join('\n');
+          nextPrecompute();
+        }, sync);
+      };
+      again();
+    }, true);
+  }
+  function nextModel() {
+    if (names.length === 0) {
+      nextPrecompute();
       return;
     }
     var name = names.shift(), model = models[name];
@@ -720,6 +1078,7 @@ function runViewer(gl, canvas, format, blobs) {
   var first = models[atmosViewerModels[0]];
   var R = first.bottom;
   var views = standardViews(first.bottom, first.top);
+  var timer = makeTimer(gl, atmosViewerParams.get('timer'));
   var el = function (id) { return document.getElementById(id); };
   var viewSelect = el('view');
   var custom = document.createElement('option');
@@ -839,10 +1198,84 @@ function runViewer(gl, canvas, format, blobs) {
     state.view = '';
     changed();
   });
-  var timer = makeTimer(gl, atmosViewerParams.get('timer'));
   var pending = false, lastMs = NaN;
+  // The atmosphere's sliders and preset menu (state keys atm, ray, mie, oz,
+  // alb): each model whose bake lists GPU passes recomputes its tables on the
+  // GPU when they change; the timings show in #precompute.
+  var atmSliders = {ray: 'ray', mie: 'mie', oz: 'oz'};
+  var presetSelect = el('atm');
+  var asBaked = document.createElement('option');
+  asBaked.textContent = '(as baked)';
+  asBaked.value = '';
+  presetSelect.appendChild(asBaked);
+  Object.keys(window.atmosViewerPresets || {}).forEach(function (name) {
+    var o = document.createElement('option');
+    o.textContent = name;
+    o.value = name;
+    presetSelect.appendChild(o);
+  });
+  var atmosphereKey = '', precomputeMs = {};
+  function showAtmosphere() {
+    presetSelect.value = state.atm;
+    Object.keys(atmSliders).forEach(function (k) {
+      el(atmSliders[k]).value = state[k];
+      el(atmSliders[k] + '_v').textContent = 'x' + fmtNum(state[k], 2);
+    });
+    el('alb').value = Math.max(0, state.alb);
+    el('alb_v').textContent = state.alb < 0 ? 'own' : fmtNum(state.alb, 2);
+  }
+  function updateAtmosphere() {
+    var key = [state.atm, state.ray, state.mie, state.oz, state.alb].join(',');
+    if (key === atmosphereKey) return;
+    atmosphereKey = key;
+    var fixed = [];
+    atmosViewerModels.forEach(function (name) {
+      try {
+        var ok = applyAtmosphere(gl, models[name], state, timer, function (ms) {
+          precomputeMs[name] = ms;
+          showPrecompute();
+        });
+        if (!ok) fixed.push(name);
+      } catch (e) {
+        // No float render targets, or a pass that does not compile: the
+        // model keeps what it had, and the page says why.
+        el('error').textContent = name + ': ' + String(e.message || e);
+        fixed.push(name);
+      }
+    });
+    // The views follow the planet (the first model's).
+    R = models[atmosViewerModels[0]].bottom;
+    views = standardViews(R, models[atmosViewerModels[0]].top);
+    el('atm_note').textContent = fixed.length ?
+        'baked atmosphere kept (no GPU passes in its bake, or the error below): ' +
+        fixed.join(', ') : '';
+  }
+  function showPrecompute() {
+    var parts = [];
+    Object.keys(precomputeMs).forEach(function (name) {
+      var ms = precomputeMs[name];
+      if (isFinite(ms)) parts.push(name + ' ' + ms.toFixed(2) + ' ms');
+    });
+    el('precompute').textContent = parts.length ?
+        'tables on the GPU: ' + parts.join(', ') + ' (' +
+            (timer.ext ? 'GPU timer query' : 'finish-bracketed, not a GPU timer') + ')' :
+        'tables: as baked (CPU)';
+  }
+  presetSelect.addEventListener('change', function () {
+    state.atm = presetSelect.value;
+    state.view = '';
+    changed();
+  });
+  Object.keys(atmSliders).forEach(function (k) {
+    el(atmSliders[k]).addEventListener('input', function () {
+      state[k] = +el(atmSliders[k]).value;
+      changed();
+    });
+  });
+  el('alb').addEventListener('input', function () { state.alb = +el('alb').value; changed(); });
   function changed() {
     showState();
+    showAtmosphere();
     publish();
     if (!pending) {
       pending = true;
@@ -859,6 +1292,7 @@ function runViewer(gl, canvas, format, blobs) {
       canvas.height = Math.round(h * dpr);
     }
     var W = canvas.width, H = canvas.height;
+    updateAtmosphere();
     var view = stateView(state, views, R);
     var opts = {raw: false, sunDisc: !!state.disc, exposure: Math.pow(2, state.exp)};
     var a = models[state.m], b = models[state.m2];
@@ -877,10 +1311,12 @@ function runViewer(gl, canvas, format, blobs) {
                                         'not a GPU timer') + '), ' + W + 'x' + H + ', tables ' +
                                 format;
     });
-    el('command').textContent = renderCommand(state, W, H);
+    el('command').textContent = renderCommand(state, W, H, models[state.m]);
   }
   showState();
+  showAtmosphere();
   publish();
+  showPrecompute();
   draw();
   el('atmos-test').setAttribute('data-status', 'viewer');
   if (atmosViewerParams.get('bench')) runBench(gl, models, state, views);

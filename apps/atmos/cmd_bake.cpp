@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,26 @@ void WriteText(const fs::path& path, const std::string& text) {
     WriteFileAtomically(path.string(), text);
 }
 
+// The GLSL files a bake's "gpu_precompute" lists (io/gpu_passes.h) that are
+// engine assets (shaders/NAME_precompute.glsl): installed beside the others.
+// The bake's JSON is the one with "gpu_precompute"; a model without passes has none.
+void InstallPrecomputeShaders(const fs::path& into) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(into, ec)) {
+        if (e.path().extension() != ".json") continue;
+        const nlohmann::json j = nlohmann::json::parse(ReadWholeFile(e.path()), nullptr, false);
+        if (!j.is_object() || !j.contains("gpu_precompute")) continue;
+        for (const auto& file : j["gpu_precompute"]["shaders"]) {
+            const std::string path = file.get<std::string>();
+            if (fs::exists(into / path)) continue;  // written by the bake (constants, common)
+            if (const char* text = FindAsset(path)) {
+                fs::create_directories((into / path).parent_path());
+                WriteText(into / path, text);
+            }
+        }
+    }
+}
+
 // Precomputes (or --load's) `common`'s model and bakes it into `dir`, shaders
 // included; returns the model's registered name.
 std::string BakeInto(const CommonOptions& common, const std::string& dir) {
@@ -49,8 +70,12 @@ std::string BakeInto(const CommonOptions& common, const std::string& dir) {
             fs::create_directories(into / "shaders");
             WriteText(into / ShaderAsset(spec.name), shader);
             WriteText(into / kCommonShader, FindAsset(kCommonShader));
+            InstallPrecomputeShaders(into);
             WriteEngineShaders(into.string(), spec.name, common.quiet);  // Vulkan, HLSL, Metal
+        } else {
+            InstallPrecomputeShaders(into);
         }
+        InstallPrecomputeShaders(into);
     });
     staged.Commit();
     if (!common.quiet) {
@@ -158,6 +183,7 @@ Command AddViewerCommand(CLI::App* root) {
             WriteText(into / "index.html", FindAsset("viewer/index.html"));
             WriteText(into / "viewer.js", FindAsset("viewer/viewer.js"));
             WriteText(into / "models.js", "var atmosViewerModels = [" + list + "];\n");
+            WriteText(into / "presets.js", ViewerPresetsScript());
         });
         staged.Commit();
         if (!common->quiet) {

@@ -14,7 +14,9 @@
 //      main() that calls atmos_Evaluate per pixel (ShadePixel of `atmos render`);
 //   5. per frame, for a model with frame tables (hillaire), the sky-view pass and
 //      the 32 aerial-perspective slice passes, then the sky pass;
-//   6. readback (rows bottom to top, as PFM stores them).
+//   6. readback (rows bottom to top, as PFM stores them);
+//   7. with --precompute, instead, the bake's "gpu_precompute" passes: the
+//      tables computed on the GPU (docs/engine.md, "Tables computed on the GPU").
 // It links the system's libEGL and libOpenGL (glvnd) and nlohmann/json; nothing
 // of atmos. Usage: `atmos_gl_host --help`.
 #define GL_GLEXT_PROTOTYPES 1
@@ -30,6 +32,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -687,9 +690,167 @@ void WritePfm(const std::string& path, int width, int height, const std::vector<
     if (!out) throw Error("cannot write '" + path + "'");
 }
 
+// ---- 7. tables computed on the GPU (docs/engine.md, "Tables computed on the GPU") ----
+
+// A render target of "gpu_precompute"."targets": an RGBA32F 2D or 3D texture.
+struct PassTarget {
+    GLenum target = GL_TEXTURE_2D;
+    GLuint texture = 0;
+    int width = 1, height = 1, depth = 1;
+};
+
+// Runs the bake's "gpu_precompute" pass list as it is (io/gpu_passes.h): per
+// pass its program ("#version 330 core", "#define ENTRY 1", the listed GLSL
+// files), its inputs on texture units, one full-screen triangle per layer of
+// its target (atmos_layer), blending ONE, ONE for "add". Each pass is timed by
+// the wall clock between glFinish calls (`repeat` runs: medians). Then every
+// table of "raw" is read back from the target of its name into a float32 blob
+// laid out as the bake's tables.f32 (same offsets), written to `output`.
+void RunPrecompute(const std::string& dir, const Bake& bake, const std::string& output,
+                   int repeat) {
+    if (!bake.json.contains("gpu_precompute")) {
+        throw Error("the bake in '" + dir +
+                    "' has no \"gpu_precompute\" (its model's tables are not computed on the GPU)");
+    }
+    const Json& pc = bake.json["gpu_precompute"];
+    std::string glsl;
+    for (const Json& file : pc["shaders"])
+        glsl += ReadFile(dir + "/" + file.get<std::string>()) + "\n";
+    CreateContext();
+    GLuint vao = 0;
+    glGenVertexArrays(1, &vao);
+    glBindVertexArray(vao);
+    std::map<std::string, PassTarget> targets;
+    for (const auto& [name, t] : pc["targets"].items()) {
+        PassTarget p;
+        p.width = t["width"];
+        p.height = t["height"];
+        p.depth = t["depth"];
+        if (t["channels"].get<int>() != 4) throw Error("target '" + name + "' is not RGBA");
+        p.target = p.depth > 1 ? GL_TEXTURE_3D : GL_TEXTURE_2D;
+        p.texture = MakeTarget(p.target, p.width, p.height, p.depth);
+        targets[name] = p;
+    }
+    std::map<std::string, GLuint> programs;  // by entry
+    const Json& passes = pc["passes"];
+    for (const Json& pass : passes) {
+        const std::string entry = pass["entry"];
+        if (!programs.count(entry)) programs[entry] = Link("#define " + entry + " 1\n" + glsl, "");
+    }
+    GLuint fb = 0;
+    glGenFramebuffers(1, &fb);
+    glBindFramebuffer(GL_FRAMEBUFFER, fb);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBlendEquation(GL_FUNC_ADD);
+    using Clock = std::chrono::steady_clock;
+    std::vector<std::vector<double>> pass_ms(passes.size());
+    std::vector<double> total_ms;
+    for (int run = 0; run < repeat; ++run) {
+        glFinish();
+        const Clock::time_point start = Clock::now();
+        for (size_t i = 0; i < passes.size(); ++i) {
+            const Json& pass = passes[i];
+            const Clock::time_point t0 = Clock::now();
+            const GLuint program = programs[pass["entry"].get<std::string>()];
+            const std::string target_name = pass["target"];
+            if (!targets.count(target_name))
+                throw Error("pass target '" + target_name + "' unknown");
+            const PassTarget& out = targets[target_name];
+            glUseProgram(program);
+            std::vector<std::string> samplers;
+            GLint unit = 0;
+            for (const auto& [sampler, input] : pass["inputs"].items()) {
+                const std::string in = input.get<std::string>();
+                if (!targets.count(in) || in == target_name) {
+                    throw Error("pass '" + pass["name"].get<std::string>() + "' reads '" + in +
+                                "'");
+                }
+                glActiveTexture(GL_TEXTURE0 + static_cast<GLenum>(unit));
+                glBindTexture(targets[in].target, targets[in].texture);
+                glUniform1i(Uniform(program, sampler.c_str()), unit++);
+                samplers.push_back(sampler);
+            }
+            if (run == 0) RequireSamplers(program, samplers);
+            for (const auto& [name, value] : pass["uniforms"].items()) {
+                glUniform1i(Uniform(program, name.c_str()), value.get<int>());
+            }
+            if (pass["blend"] == "add") {
+                glEnable(GL_BLEND);
+            } else {
+                glDisable(GL_BLEND);
+            }
+            glViewport(0, 0, out.width, out.height);
+            const GLint layer = Uniform(program, "atmos_layer");
+            for (int z = 0; z < out.depth; ++z) {
+                if (out.target == GL_TEXTURE_3D) {
+                    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, out.texture, 0,
+                                              z);
+                } else {
+                    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D,
+                                           out.texture, 0);
+                }
+                if (z == 0 && glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+                    throw Error("RGBA32F target '" + target_name + "' incomplete");
+                }
+                glUniform1i(layer, z);
+                glDrawArrays(GL_TRIANGLES, 0, 3);
+            }
+            glFinish();
+            pass_ms[i].push_back(
+                std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+            CheckGl(pass["name"].get<std::string>().c_str());
+        }
+        total_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+    }
+    glDisable(GL_BLEND);
+    // The tables, laid out as "raw" (channel fastest, then x, y, layer).
+    const Json& raw = bake.json["raw"];
+    std::vector<float> blob(raw["float32"]["bytes"].get<size_t>() / 4, 0.0f);
+    for (const auto& [name, entry] : raw["tables"].items()) {
+        if (!targets.count(name)) throw Error("the passes compute no table '" + name + "'");
+        const PassTarget& t = targets[name];
+        const int c = entry["channels"];
+        const size_t texels = static_cast<size_t>(t.width) * t.height * t.depth;
+        if (entry["width"] != t.width || entry["height"] != t.height || entry["depth"] != t.depth ||
+            entry["float32_offset"].get<size_t>() / 4 + texels * c > blob.size()) {
+            throw Error("target '" + name + "' does not match its table in \"raw\"");
+        }
+        std::vector<float> rgba(texels * 4);
+        glBindTexture(t.target, t.texture);
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        glGetTexImage(t.target, 0, GL_RGBA, GL_FLOAT, rgba.data());
+        float* dst = blob.data() + entry["float32_offset"].get<size_t>() / 4;
+        for (size_t i = 0; i < texels; ++i) {
+            for (int ch = 0; ch < c; ++ch) dst[i * c + ch] = rgba[i * 4 + ch];
+        }
+    }
+    CheckGl("readback");
+    std::ofstream file(output, std::ios::binary);
+    file.write(reinterpret_cast<const char*>(blob.data()),
+               static_cast<std::streamsize>(blob.size() * sizeof(float)));
+    if (!file) throw Error("cannot write '" + output + "'");
+    auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        return v[v.size() / 2];
+    };
+    const std::string renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    std::printf(
+        "%s precompute on %s%s: %zu passes, %.1f ms (medians of %d runs, glFinish-bracketed "
+        "wall clock per pass)\n",
+        bake.json["model"].get<std::string>().c_str(), renderer.c_str(),
+        renderer.find("llvmpipe") != std::string::npos ? " (CPU-emulated: Mesa llvmpipe)" : "",
+        passes.size(), median(total_ms), repeat);
+    for (size_t i = 0; i < passes.size(); ++i) {
+        const Json& pass = passes[i];
+        std::printf("  %-44s %-20s %10.2f ms\n", pass["name"].get<std::string>().c_str(),
+                    pass["target"].get<std::string>().c_str(), median(pass_ms[i]));
+    }
+}
+
 constexpr const char* kUsage =
     "usage: atmos_gl_host BAKE_DIR (--view NAME | --camera K=V,... --sun K=V,...) -o OUT.pfm\n"
     "                     [--size WxH] [--format f32|f16] [--sun-disc] [--repeat N] [--info]\n"
+    "       atmos_gl_host BAKE_DIR --precompute OUT.f32 [--repeat N]\n"
     "Renders one view of a bake (`atmos bake --model NAME -o BAKE_DIR`) with OpenGL 3.3 core\n"
     "(EGL, headless) into an RGBA32F framebuffer and writes the linear radiance as PFM, as\n"
     "`atmos render --load BAKE_DIR` of the same view.\n"
@@ -699,12 +860,15 @@ constexpr const char* kUsage =
     "  --size WxH      framebuffer size (default 320x180)\n"
     "  --format f32|f16  which blob to upload (default f32)\n"
     "  --sun-disc      add the sun's uniform disc\n"
-    "  --repeat N      draw the frame N times and print the median frame time\n"
+    "  --repeat N      draw the frame (or run the passes) N times and print median times\n"
+    "  --precompute OUT.f32  run the bake's \"gpu_precompute\" passes, write the tables they\n"
+    "                  compute as a float32 blob laid out as the bake's tables.f32 and print\n"
+    "                  each pass's time\n"
     "  --info          print the GL renderer and exit\n"
     "Exit status: 0 ok, 2 bad input or GL error, 3 no OpenGL 3.3 context (EGL).\n";
 
 int Run(int argc, char** argv) {
-    std::string dir, view_name, camera, sun, output, format = "f32";
+    std::string dir, view_name, camera, sun, output, format = "f32", precompute;
     int width = 320, height = 180, repeat = 1;
     bool sun_disc = false, info = false;
     for (int i = 1; i < argc; ++i) {
@@ -735,6 +899,8 @@ int Run(int argc, char** argv) {
         } else if (a == "--repeat") {
             repeat = std::atoi(value().c_str());
             if (repeat < 1 || repeat > 10000) throw Error("--repeat must be in [1, 10000]");
+        } else if (a == "--precompute") {
+            precompute = value();
         } else if (a == "--sun-disc") {
             sun_disc = true;
         } else if (a == "--info") {
@@ -749,6 +915,14 @@ int Run(int argc, char** argv) {
         CreateContext();
         std::printf("%s | %s | GLSL %s\n", glGetString(GL_RENDERER), glGetString(GL_VERSION),
                     glGetString(GL_SHADING_LANGUAGE_VERSION));
+        return 0;
+    }
+    if (!precompute.empty()) {
+        if (dir.empty()) throw Error("--precompute needs BAKE_DIR (--help)");
+        if (!view_name.empty() || !camera.empty() || !output.empty()) {
+            throw Error("--precompute writes tables: no --view, --camera or -o");
+        }
+        RunPrecompute(dir, LoadBake(dir, false), precompute, repeat);
         return 0;
     }
     if (dir.empty() || output.empty()) throw Error("need BAKE_DIR and -o OUT.pfm (--help)");

@@ -43,6 +43,10 @@ struct ModelCapabilities {
     // form of its own (preetham). false: compare/bench skip it in spectral
     // runs and --wavelengths refuses it.
     bool spectral = true;
+    // Monte Carlo models whose paths carry any number of wavelengths at once
+    // (hero-wavelength sampling): a spectral run gives them all its wavelengths
+    // in one set of paths (Model::SetSpectralPaths) instead of batches of three.
+    bool spectral_paths = false;
     // `atmos fit` trains its weights against a reference model.
     bool trainable = false;
     // Wide channel batches (docs/performance.md "Wide channel batches"): one
@@ -87,6 +91,12 @@ struct ValidityDomain {
     // constituents, largest channel: VerticalOpticalDepth).
     double max_optical_depth = 0.0;
     std::string optical_depth_reason;
+    // A fitted sky (preetham, hosek-wilkie): the atmosphere its coefficients
+    // were fitted to, by name ("earth", a preset or a file). Its sky does not
+    // follow another planet's, so the planet must match
+    // (AtmosphereShapeDifferences). Null: no check.
+    std::string fitted_to;
+    std::shared_ptr<const AtmosphereParameters> fitted_atmosphere;
 };
 
 struct ModelInfo {
@@ -232,6 +242,23 @@ class Model {
     // spectral form of its own (preetham) builds it in the Prepare() that follows.
     virtual void SetSpectralBatch(const SpectralAtmosphere& /*atmosphere*/,
                                   const double /*nm*/[3]) {}
+    // Monte Carlo models whose paths carry any number of wavelengths at once
+    // (ModelCapabilities::spectral_paths: hero-wavelength sampling): a spectral
+    // run (harness/spectral_run.h) gives them all its wavelengths instead of
+    // batches of three. SetSpectralPaths(atmosphere, nm) comes before the one
+    // Prepare() (given the atmosphere at three of the wavelengths); then
+    // RenderSpectralPaths writes the radiance per unit solar irradiance of
+    // every pixel at every wavelength,
+    // (*values)[(y * width + x) * nm.size() + i], from request.monte_carlo's spp
+    // and seed (radiance, no sun disc), and SampleSpectralPaths the radiance per
+    // unit irradiance of each query (sky; plus ground where the query asks),
+    // [q * nm.size() + i], mc.spp paths from mc.seed. Others throw atmos::Error.
+    virtual void SetSpectralPaths(const SpectralAtmosphere& atmosphere,
+                                  const std::vector<double>& nm);
+    virtual void RenderSpectralPaths(const RenderRequest& request,
+                                     std::vector<float>* values) const;
+    virtual std::vector<float> SampleSpectralPaths(const std::vector<SampleQuery>& queries,
+                                                   const MonteCarloSettings& mc) const;
     // Renders the view's radiance (times the view's irradiance and the
     // atmosphere's solar irradiance) or transmittance into `out` (resized).
     virtual void Render(const RenderRequest& request, Image* out) const = 0;
@@ -313,6 +340,14 @@ std::vector<std::string> ValidityDomainViolations(const ModelInfo& info,
 // Prints "atmos: warning: model NAME: outside its valid domain: REASON" on
 // stderr for each violation (models call it at the start of Prepare()).
 void WarnOutsideValidityDomain(const ModelInfo& info, const AtmosphereParameters& atmosphere);
+// Where `atmosphere` is another planet than `fit`: its bottom_radius more than
+// 2 % apart, or its air (rayleigh_density) a profile more than 10 % apart, as
+// "FIELD VALUE (fit: VALUE)". Earth's variants (a 60 km shell, no ozone, other
+// aerosols: a fitted sky's turbidity stands for those) are the same planet;
+// the scattering coefficients are not compared (a spectral run's batches
+// change them).
+std::vector<std::string> AtmosphereShapeDifferences(const AtmosphereParameters& atmosphere,
+                                                    const AtmosphereParameters& fit);
 
 // All registered models, in the registry's order (src/atmos/models/registry.cpp).
 std::vector<ModelInfo> ListModels();

@@ -71,6 +71,7 @@ py::dict InfoDict(const ModelInfo& info) {
     caps["precomputed"] = c.precomputed;
     caps["stochastic"] = c.stochastic;
     caps["spectral"] = c.spectral;
+    caps["spectral_paths"] = c.spectral_paths;
     caps["trainable"] = c.trainable;
     caps["shader"] = c.shader;
     caps["validity_notes"] = c.validity_notes;

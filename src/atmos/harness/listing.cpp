@@ -43,6 +43,11 @@ std::string ModelCapabilitiesText(const ModelInfo& info) {
         {d.max_radius_heights, "planet radius", " column heights", d.radius_heights_reason},
         {d.max_optical_depth, "vertical optical depth", "", d.optical_depth_reason},
     };
+    if (d.fitted_atmosphere) {
+        text += Line("valid domain: the atmosphere its sky is fitted to, '" + d.fitted_to +
+                     "' (its planet radius and air profile); on another planet it warns and gives "
+                     "that sky anyway");
+    }
     for (const auto& l : limits) {
         if (l.max <= 0.0) continue;
         text += Line(std::string("valid domain: ") + l.what + " up to " + Number(l.max) + l.unit +

@@ -76,6 +76,39 @@ void ForEachWideGroup(const ModelSpec& spec, const SpectralAtmosphere& atmospher
     }
 }
 
+// A Monte Carlo model whose paths carry many wavelengths at once
+// (ModelCapabilities::spectral_paths, hero-wavelength sampling: docs/models/reference.md)
+// takes all of a run's wavelengths in one set of paths: the model gets them
+// (SetSpectralPaths) and one Prepare() with the atmosphere at the shortest, the
+// middle and the longest of them. Only where that is the same work as the
+// batches: more than one batch, on the CPU, radiance (`renders`: without the
+// sun's disc or a noise target, which the batches' progressive driver
+// provides). Null: the batches.
+std::unique_ptr<Model> SpectralPathsModel(const ModelSpec& spec,
+                                          const SpectralAtmosphere& atmosphere,
+                                          const std::vector<double>& nm,
+                                          const std::vector<RenderRequest>* renders,
+                                          const PrepareFunction& prepare) {
+    if (nm.size() <= 3 || CurrentBackend() != Backend::kCpu) return nullptr;
+    if (renders) {
+        for (const RenderRequest& r : *renders) {
+            if (r.quantity != Quantity::kRadiance || r.sun_disc ||
+                r.monte_carlo.noise_target > 0.0) {
+                return nullptr;
+            }
+        }
+    }
+    std::unique_ptr<Model> model = CreateModel(spec);
+    const ModelCapabilities& caps = model->Info().capabilities;
+    if (!caps.stochastic || !caps.spectral_paths) return nullptr;
+    std::vector<double> sorted = nm;
+    std::sort(sorted.begin(), sorted.end());
+    model->SetSpectralPaths(atmosphere, nm);
+    prepare(atmosphere.AtWavelengths(sorted.front(), sorted[sorted.size() / 2], sorted.back()),
+            model.get());
+    return model;
+}
+
 }  // namespace
 
 bool ParseChannelBatches(const std::string& text) {
@@ -184,6 +217,33 @@ std::vector<SpectralImage> RenderSpectralRequests(
             });
         return out;
     }
+    if (std::unique_ptr<Model> model =
+            SpectralPathsModel(spec, atmosphere, nm, &requests, prepare)) {
+        // Hero-wavelength paths: every wavelength at once, the run's seed.
+        std::vector<float> irradiance(n);
+        for (size_t v = 0; v < requests.size(); ++v) {
+            RenderRequest r = requests[v];
+            r.checkpoint.clear();
+            r.resume = false;
+            r.variance = nullptr;
+            for (size_t i = 0; i < n; ++i) {
+                irradiance[i] = static_cast<float>(atmosphere.solar_irradiance.At(nm[i]) *
+                                                   r.view.sun_irradiance);
+            }
+            std::vector<float> values;
+            const auto start = std::chrono::steady_clock::now();
+            model->RenderSpectralPaths(r, &values);
+            if (render_seconds) {
+                (*render_seconds)[v] +=
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            }
+            if (reports) (*reports)[v].samples = r.monte_carlo.spp;
+            for (size_t k = 0; k < values.size(); ++k) {
+                out[v].values[k] = values[k] * irradiance[k % n];
+            }
+        }
+        return out;
+    }
     ForEachPreparedBatch(
         spec, atmosphere, nm, batching.layout, prepare,
         [&](size_t b, const std::array<size_t, 3>& indices, size_t stored, Model& model,
@@ -264,6 +324,14 @@ std::vector<double> SampleSpectral(const ModelSpec& spec, const SpectralAtmosphe
                                  }
                              }
                          });
+        return out;
+    }
+    if (std::unique_ptr<Model> model = SpectralPathsModel(spec, atmosphere, nm, nullptr, prepare)) {
+        const std::vector<float> values = model->SampleSpectralPaths(queries, monte_carlo);
+        for (size_t k = 0; k < values.size(); ++k) {
+            // As the batches: the float radiance times the solar spectrum.
+            out[k] = static_cast<double>(values[k]) * atmosphere.solar_irradiance.At(nm[k % n]);
+        }
         return out;
     }
     ForEachPreparedBatch(

@@ -5,7 +5,11 @@
 // neighbours on request; a short batch repeats its last wavelength), prepares a fresh model per
 // batch and renders or samples it: the models are unchanged, as in Bruneton 2017's precomputation
 // of N wavelengths in batches. Monte Carlo models take a seed per batch (SpectralBatching; no
-// checkpoints or variance).
+// checkpoints or variance). A Monte Carlo model whose paths carry many wavelengths
+// (ModelCapabilities::spectral_paths: the reference's hero-wavelength paths) instead gets all
+// of them at once, one Prepare() and one set of paths from the run's seed, where the run has
+// more than three wavelengths on the CPU and renders radiance without the sun's disc or a
+// noise target (batching does not apply to it).
 #pragma once
 
 #include <array>

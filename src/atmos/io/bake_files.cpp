@@ -5,12 +5,15 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "atmos/atmosphere.h"
 #include "atmos/error.h"
 #include "atmos/model.h"
 #include "io/output_path.h"
+#include "io/raw_tables.h"
 #include "io/text_files.h"
 
 namespace atmos {
@@ -78,11 +81,56 @@ void WriteViewerData(const fs::path& dir, const std::string& name) {
     for (char& c : file) {
         if (c == '-') c = '_';
     }
-    const std::string constants = ReadWholeFile(dir / "shaders" / (file + "_constants.glsl"));
-    WriteFileAtomically((dir / "model.js").string(),
-                        "atmosViewerData.models[" + JsStringLiteral(name) + "] = {bake: " +
-                            j.dump() + ", constants: " + JsStringLiteral(constants) +
-                            ", functions: " + JsStringLiteral(functions) + "};\n");
+    const std::string constants_path = "shaders/" + file + "_constants.glsl";
+    const std::string constants = ReadWholeFile(dir / constants_path);
+    // The constants split where the atmosphere's #defines end (the page
+    // regenerates them for another atmosphere: ViewerPresetsScript), and the
+    // text of every other shader of the bake's GPU passes (io/gpu_passes.h).
+    std::string model_constants = constants;
+    if (j.contains("atmosphere")) {
+        std::ostringstream atmosphere;
+        WriteGlslAtmosphere(atmosphere, AtmosphereFromJson(j["atmosphere"].dump(), name));
+        const size_t at = constants.find(atmosphere.str());
+        if (at == std::string::npos) {
+            Fail(json_path.string(), ": its constants do not hold its atmosphere's #defines");
+        }
+        model_constants = constants.substr(at + atmosphere.str().size());
+    }
+    std::string sources;
+    if (j.contains("gpu_precompute") && j["gpu_precompute"].contains("shaders")) {
+        for (const auto& path : j["gpu_precompute"]["shaders"]) {
+            const std::string p = path.get<std::string>();
+            if (p == constants_path) continue;  // the page writes its own
+            sources += (sources.empty() ? "" : ", ") + JsStringLiteral(p) + ": " +
+                       JsStringLiteral(ReadWholeFile(dir / p));
+        }
+    }
+    WriteFileAtomically(
+        (dir / "model.js").string(),
+        "atmosViewerData.models[" + JsStringLiteral(name) + "] = {bake: " + j.dump() +
+            ", constants: " + JsStringLiteral(constants) +
+            ", constantsPath: " + JsStringLiteral(constants_path) +
+            ", modelConstants: " + JsStringLiteral(model_constants) +
+            ", functions: " + JsStringLiteral(functions) + ", sources: {" + sources + "}};\n");
+}
+
+std::string ViewerPresetsScript() {
+    std::string out = "var atmosViewerPresets = {";
+    bool first = true;
+    for (const std::string& name : AtmospherePresetNames()) {
+        const AtmosphereParameters a = LoadAtmosphere(name);
+        std::ostringstream constants;
+        WriteGlslAtmosphere(constants, a);
+        nlohmann::ordered_json albedo = {a.ground_albedo[0], a.ground_albedo[1],
+                                         a.ground_albedo[2]};
+        out += std::string(first ? "" : ",") + "\n  " + JsStringLiteral(name) +
+               ": {constants: " + JsStringLiteral(constants.str()) +
+               ", bottom: " + nlohmann::ordered_json(a.bottom_radius).dump() +
+               ", top: " + nlohmann::ordered_json(a.top_radius).dump() +
+               ", albedo: " + albedo.dump() + "}";
+        first = false;
+    }
+    return out + "\n};\n";
 }
 
 // The model spec of the bake in `dir` (--load without --model): the JSON a

@@ -20,8 +20,15 @@ std::vector<std::string> ShaderModels();
 
 // Thins the bake in `dir` to one copy of each table (tables.f32; its EXR
 // files and tables.f16 are removed and its JSON says so) and writes the page's
-// view of it: model.js (its JSON, constants and functions).
+// view of it: model.js (its JSON, constants and functions; the constants
+// past the atmosphere's #defines, "modelConstants"; and the text of every
+// other shader its GPU passes list, "sources": io/gpu_passes.h).
 void WriteViewerData(const std::filesystem::path& dir, const std::string& name);
+
+// The page's presets.js: every embedded atmosphere preset (AtmospherePresetNames)
+// as its shaders' #defines (WriteGlslAtmosphere, computed here in C++), radii
+// and ground albedo, for the viewer's planet-preset menu.
+std::string ViewerPresetsScript();
 
 // The model spec of the bake in `dir` (--load without --model): the JSON a
 // model's Bake writes names the model ("model") and every option ("options").

@@ -4,6 +4,8 @@
 #include "io/engine_shaders.h"
 
 #include <sys/wait.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -11,6 +13,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "atmos/error.h"
 #include "io/output_path.h"
@@ -168,6 +172,43 @@ Source RewriteForVulkan(const std::string& text, int* next_binding, std::vector<
     return out;
 }
 
+// The GPU precomputation's passes (io/gpu_passes.h) as one Vulkan fragment
+// stage: the WebGL2 source's helpers (everything before its "// ---- passes
+// ----" line) once, then, per entry of the bake's pass list, its passes'
+// section with that entry defined and its main() renamed atmos_pass_N; main()
+// calls the pass that the specialization constant ATMOS_PASS (constant_id 0)
+// selects. atmos_layer is a push constant; the samplers get bindings after the
+// model's. Returns "" when the file has no passes section.
+std::string PrecomputeStage(const std::string& text, const std::vector<std::string>& entries,
+                            int* next_binding, std::vector<Binding>* all) {
+    const size_t split = text.find("\n// ---- passes ----");
+    if (split == std::string::npos) return "";
+    std::string helpers = text.substr(0, split + 1);
+    const std::string passes = text.substr(split + 1);
+    const auto replace = [](std::string* s, const std::string& from, const std::string& to) {
+        const size_t at = s->find(from);
+        if (at != std::string::npos) s->replace(at, from.size(), to);
+    };
+    replace(&helpers, "\nuniform int atmos_layer;\n",
+            "\nlayout(push_constant) uniform AtmosPass { int atmos_layer; };\n");
+    replace(&helpers, "\nout vec4 atmos_out;\n", "\nlayout(location = 0) out vec4 atmos_out;\n");
+    std::string out = "layout(constant_id = 0) const int ATMOS_PASS = 0;\n" +
+                      RewriteForVulkan(helpers, next_binding, all).text;
+    std::string calls;
+    for (size_t i = 0; i < entries.size(); ++i) {
+        const std::string fn = "atmos_pass_" + std::to_string(i);
+        std::string body = passes;
+        for (size_t at = body.find("void main()"); at != std::string::npos;
+             at = body.find("void main()", at + 1)) {
+            body.replace(at, 11, "void " + fn + "()");
+        }
+        out += "\n#define " + entries[i] + " 1\n" + body + "#undef " + entries[i] + "\n";
+        calls += "    " + std::string(i ? "else " : "") + "if (ATMOS_PASS == " + std::to_string(i) +
+                 ") " + fn + "();  // " + entries[i] + "\n";
+    }
+    return out + "\nvoid main() {\n" + calls + "}\n";
+}
+
 std::string Quote(const fs::path& p) {
     std::string s = "'";
     for (char c : p.string()) {
@@ -261,6 +302,37 @@ void WriteEngineShaders(const std::string& dir_text, const std::string& model_na
             {file + "_sky_view.comp", "comp", header + prelude + sky_decl + kSkyViewMain});
         stages.push_back({file + "_aerial_perspective.comp", "comp",
                           header + prelude + ap_decl + kAerialPerspectiveMain});
+    }
+    // The bake's GPU precomputation ("gpu_precompute" of its JSON, whose files
+    // `atmos bake` has installed): one fragment stage for all its passes.
+    std::vector<std::string> entries;
+    std::string precompute_file;
+    for (const auto& e : fs::directory_iterator(dir)) {
+        if (e.path().extension() != ".json") continue;
+        const nlohmann::json j = nlohmann::json::parse(ReadWholeFile(e.path()), nullptr, false);
+        if (!j.is_object() || !j.contains("gpu_precompute")) continue;
+        for (const auto& pass : j["gpu_precompute"]["passes"]) {
+            const std::string entry = pass["entry"];
+            if (std::find(entries.begin(), entries.end(), entry) == entries.end()) {
+                entries.push_back(entry);
+            }
+        }
+        const auto& files = j["gpu_precompute"]["shaders"];
+        if (!files.empty()) precompute_file = files.back().get<std::string>();
+    }
+    if (!entries.empty() && fs::exists(dir / precompute_file)) {
+        const std::string stage = PrecomputeStage(ReadWholeFile(dir / precompute_file), entries,
+                                                  &next_binding, &bindings);
+        if (!stage.empty()) {
+            stages.push_back({file + "_precompute.frag", "frag", header + prelude + stage});
+            bindings_json += "  \"precompute\": {\"stage\": \"" + file +
+                             "_precompute.frag\", \"specialization constant 0 (ATMOS_PASS)\": {";
+            for (size_t i = 0; i < entries.size(); ++i) {
+                bindings_json +=
+                    std::string(i ? ", " : "") + "\"" + entries[i] + "\": " + std::to_string(i);
+            }
+            bindings_json += "}, \"push constant\": \"int atmos_layer\"},\n";
+        }
     }
     bindings_json += "  \"bindings\": [\n";
     for (size_t i = 0; i < bindings.size(); ++i) {

@@ -10,7 +10,9 @@ namespace atmos {
 // common.glsl, NAME.glsl), writes complete Vulkan GLSL stages
 // DIR/shaders/vulkan/NAME.vert, NAME.frag (and, for a shader that defines the
 // per-frame passes atmos_SkyViewTexel / atmos_AerialPerspectiveTexel, the compute
-// stages NAME_sky_view.comp and NAME_aerial_perspective.comp) with a uniform
+// stages NAME_sky_view.comp and NAME_aerial_perspective.comp; for a bake whose
+// JSON has "gpu_precompute", NAME_precompute.frag: all its passes, the pass
+// chosen by specialization constant 0) with a uniform
 // block and explicit bindings, their bindings as DIR/shaders/vulkan/NAME_bindings.json,
 // and, with Debian's glslangValidator and spirv-cross on the PATH, their SPIR-V
 // (DIR/shaders/spirv/*.spv), HLSL (DIR/shaders/hlsl/*.hlsl, shader model 5.0) and

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "atmos/error.h"
+#include "io/gpu_passes.h"
 #include "io/output_path.h"
 #include "io/raw_tables.h"
 #include "io/table_io.h"
@@ -244,6 +245,9 @@ std::string GlslConstants(const AtmosphereParameters& a, const BrunetonConfig& c
     s << "#define ATMOS_SCATTERING_MU_S " << c.scattering_mu_s << "\n";
     s << "#define ATMOS_SCATTERING_NU " << c.scattering_nu << "\n";
     s << "#define ATMOS_COMBINED_MIE " << (c.combined_mie ? 1 : 0) << "\n";
+    // The view-ray quadrature of the precomputation (shaders/bruneton_precompute.glsl).
+    s << "#define ATMOS_SCATTERING_SAMPLES " << c.scattering_samples << "\n";
+    s << "#define ATMOS_SCATTERING_RULE " << c.scattering_rule << "\n";
     // The low-sun single Mie integral of SkyRadianceToPoint (issue 15).
     s << "#define ATMOS_LOW_SUN_MIE " << c.low_sun_mie << "\n";
     s << "#define ATMOS_LOW_SUN_MIE_STEPS " << c.low_sun_mie_steps << "\n";
@@ -260,6 +264,90 @@ std::vector<RawTable> RawTables(const BrunetonTables& tables, const BrunetonConf
                                  {"scattering", &tables.scattering}};
     if (!config.combined_mie) raw.push_back({"single_mie_scattering", &tables.single_mie});
     return raw;
+}
+}  // namespace
+
+namespace {
+// The precomputation as GPU passes (io/gpu_passes.h; shaders/bruneton_precompute.glsl):
+// the stages of PrecomputeBrunetonWith in its order, on targets sized from the config.
+GpuPrecompute BrunetonGpuPrecompute(const BrunetonConfig& c) {
+    GpuPrecompute p;
+    p.shaders = {"shaders/bruneton_constants.glsl", "shaders/common.glsl", "shaders/bruneton.glsl",
+                 "shaders/bruneton_precompute.glsl"};
+    const int width = c.scattering_nu * c.scattering_mu_s;
+    const GpuTarget scattering{width, c.scattering_mu, c.scattering_r, 4};
+    const GpuTarget irradiance{c.irradiance_width, c.irradiance_height, 1, 4};
+    p.targets["transmittance"] = {c.transmittance_width, c.transmittance_height, 1, 4};
+    p.targets["delta_irradiance"] = irradiance;
+    p.targets["irradiance"] = irradiance;
+    p.targets["delta_rayleigh"] = scattering;
+    p.targets["delta_mie"] = scattering;
+    p.targets["scattering"] = scattering;
+    if (!c.combined_mie) p.targets["single_mie_scattering"] = scattering;
+    if (c.orders > 1) {
+        p.targets["directions"] = {512, 1, 1, 4};
+        p.targets["incident"] = {512, c.scattering_mu_s, c.scattering_r, 4};
+        p.targets["delta_density"] = scattering;
+        p.targets["delta_multiple"] = scattering;
+    }
+    const auto pass = [&p](const std::string& name, const std::string& entry,
+                           const std::string& target, std::map<std::string, std::string> inputs,
+                           bool add = false) {
+        GpuPass g;
+        g.name = name;
+        g.entry = "ATMOS_PASS_" + entry;
+        g.target = target;
+        g.inputs = std::move(inputs);
+        g.add = add;
+        p.passes.push_back(std::move(g));
+    };
+    const std::string kT = "atmos_transmittance_texture";
+    const std::string kRay = "atmos_delta_rayleigh_texture", kMie = "atmos_delta_mie_texture";
+    const std::string kMul = "atmos_delta_multiple_texture";
+    pass("transmittance", "TRANSMITTANCE", "transmittance", {});
+    pass("direct irradiance", "DIRECT_IRRADIANCE", "delta_irradiance", {{kT, "transmittance"}});
+    pass("single Rayleigh scattering", "SINGLE_RAYLEIGH", "delta_rayleigh",
+         {{kT, "transmittance"}});
+    pass("single Mie scattering", "SINGLE_MIE", "delta_mie", {{kT, "transmittance"}});
+    pass("scattering after order 1", "SINGLE_TO_SCATTERING", "scattering",
+         {{kRay, "delta_rayleigh"}, {kMie, "delta_mie"}});
+    if (!c.combined_mie) {
+        pass("single Mie table", "COPY_3D", "single_mie_scattering",
+             {{"atmos_source_3d", "delta_mie"}});
+    }
+    if (c.orders == 1) pass("irradiance (single scattering only)", "ZERO", "irradiance", {});
+    if (c.orders > 1) pass("density directions", "DIRECTIONS", "directions", {});
+    for (int order = 2; order <= c.orders; ++order) {
+        const std::string n = " (order " + std::to_string(order) + ")";
+        if (order == 2) {
+            pass("incident radiance" + n, "INCIDENT_SINGLE", "incident",
+                 {{kT, "transmittance"},
+                  {kRay, "delta_rayleigh"},
+                  {kMie, "delta_mie"},
+                  {"atmos_irradiance_texture", "delta_irradiance"}});
+        } else {
+            pass("incident radiance" + n, "INCIDENT_MULTIPLE", "incident",
+                 {{kT, "transmittance"},
+                  {kMul, "delta_multiple"},
+                  {"atmos_irradiance_texture", "delta_irradiance"}});
+        }
+        pass("scattering density" + n, "SCATTERING_DENSITY", "delta_density",
+             {{"atmos_incident_texture", "incident"}, {"atmos_directions_texture", "directions"}});
+        if (order == 2) {
+            pass("indirect irradiance" + n, "INDIRECT_IRRADIANCE_SINGLE", "delta_irradiance",
+                 {{kRay, "delta_rayleigh"}, {kMie, "delta_mie"}});
+        } else {
+            pass("indirect irradiance" + n, "INDIRECT_IRRADIANCE_MULTIPLE", "delta_irradiance",
+                 {{kMul, "delta_multiple"}});
+        }
+        pass("add irradiance" + n, "COPY_2D", "irradiance",
+             {{"atmos_source_2d", "delta_irradiance"}}, order > 2);
+        pass("multiple scattering" + n, "MULTIPLE_SCATTERING", "delta_multiple",
+             {{kT, "transmittance"}, {"atmos_delta_density_texture", "delta_density"}});
+        pass("accumulate" + n, "ACCUMULATE", "scattering", {{"atmos_source_3d", "delta_multiple"}},
+             true);
+    }
+    return p;
 }
 }  // namespace
 
@@ -334,6 +422,7 @@ void BrunetonModel::Bake(const std::string& directory) const {
     j["atmosphere"] = nlohmann::ordered_json::parse(AtmosphereToJson(atm_));
     j["raw"] = WriteRawTables(directory, RawTables(tables_, config_));
     j["shaders"] = WriteGlslConstants(directory, "bruneton", GlslConstants(atm_, config_));
+    j["gpu_precompute"] = GpuPrecomputeJson(BrunetonGpuPrecompute(config_));
     const std::string path = (dir / kBakeJson).string();
     WriteFileAtomically(path, j.dump(2) + "\n");
 }

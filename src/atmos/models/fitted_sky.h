@@ -22,6 +22,20 @@ inline ModelCapabilities FittedSkyCapabilities() {
     return c;
 }
 
+// Their validity domain: a sky fitted to `name`'s (`fit`'s) radii, density
+// profiles and Mie asymmetry (ValidityDomain::fitted_to); Prepare() warns on
+// another atmosphere.
+inline ValidityDomain FittedSkyDomain(const std::string& name, const AtmosphereParameters& fit) {
+    ValidityDomain d;
+    d.fitted_to = name;
+    d.fitted_atmosphere = std::make_shared<const AtmosphereParameters>(fit);
+    return d;
+}
+inline ValidityDomain FittedToEarthDomain() {
+    static const ValidityDomain earth = FittedSkyDomain("earth", EarthAtmosphere());
+    return earth;
+}
+
 // The sun direction, raised to the horizon of `up` when below it; *cos_s is
 // its cosine to `up` (0 when raised).
 ATMOS_HD inline Vec3d SunRaisedToHorizon(const Vec3d& up, const Vec3d& sun, double* cos_s) {

@@ -12,6 +12,7 @@
 
 #include "atmos/error.h"
 #include "base/parallel.h"
+#include "io/gpu_passes.h"
 #include "io/output_path.h"
 #include "io/raw_tables.h"
 #include "io/table_io.h"
@@ -277,12 +278,35 @@ std::string HillaireGlslConstants(const AtmosphereParameters& a, const HillaireO
     s << "#define ATMOS_TRANSMITTANCE_WIDTH " << kHillaireTransmittanceWidth << "\n";
     s << "#define ATMOS_TRANSMITTANCE_HEIGHT " << kHillaireTransmittanceHeight << "\n";
     s << "#define ATMOS_STEPS " << o.steps << "\n";
+    s << "#define ATMOS_TRANSMITTANCE_STEPS " << o.transmittance_steps << "\n";
     s << "#define ATMOS_SKY_VIEW_STEPS " << o.sky_view_steps << "\n";
     s << "#define ATMOS_AP_STEPS_PER_SLICE " << o.ap_steps_per_slice << "\n";
     s << "#define ATMOS_AP_METRES_PER_SLICE " << o.ap_km_per_slice * 1000.0 << "\n";
     s << "#define ATMOS_SEGMENT_OFFSET " << o.segment_offset << "\n";
     s << "#define ATMOS_GROUND_FROM_AP " << (o.ground_from_ap ? 1 : 0) << "\n";
     return s.str();
+}
+
+// The GPU passes that compute the two tables from the constants
+// (shaders/hillaire_precompute.glsl; io/gpu_passes.h): the transmittance
+// table, then the multiple-scattering table from it.
+GpuPrecompute HillaireGpuPrecompute() {
+    GpuPrecompute p;
+    p.shaders = {"shaders/hillaire_constants.glsl", "shaders/common.glsl", "shaders/hillaire.glsl",
+                 "shaders/hillaire_precompute.glsl"};
+    p.targets["transmittance"] = {kHillaireTransmittanceWidth, kHillaireTransmittanceHeight, 1, 4};
+    p.targets["multiple_scattering"] = {kHillaireMsSize, kHillaireMsSize, 1, 4};
+    GpuPass t;
+    t.name = "transmittance";
+    t.entry = "ATMOS_HILLAIRE_TRANSMITTANCE";
+    t.target = "transmittance";
+    GpuPass ms;
+    ms.name = "multiple_scattering";
+    ms.entry = "ATMOS_HILLAIRE_MULTIPLE_SCATTERING";
+    ms.target = "multiple_scattering";
+    ms.inputs["atmos_transmittance_texture"] = "transmittance";
+    p.passes = {t, ms};
+    return p;
 }
 
 }  // namespace
@@ -342,6 +366,7 @@ void HillaireModel::Bake(const std::string& directory) const {
     j["shaders"] = nlohmann::json::parse(
         WriteGlslConstants(directory, "hillaire", HillaireGlslConstants(evaluator_.atm, options_))
             .dump());
+    j["gpu_precompute"] = nlohmann::json::parse(GpuPrecomputeJson(HillaireGpuPrecompute()).dump());
     WriteFileAtomically((fs::path(directory) / kBakeJson).string(), j.dump(2) + "\n");
 }
 

@@ -153,6 +153,20 @@ double HosekWilkieSolarIrradiance(double nm) {
            kHosekWilkieSunSolidAngle;
 }
 
+namespace {
+
+// The validity domain of a fitted file: the atmosphere `atmos fit` recorded in
+// its "fit"."atmosphere_parameters" (none recorded: no check).
+ValidityDomain FittedFileDomain(const HosekWilkieCoefficients& c, const std::string& path) {
+    const nlohmann::json fit = nlohmann::json::parse(c.fit_json, nullptr, false);
+    if (!fit.is_object() || !fit.contains("atmosphere_parameters")) return {};
+    return FittedSkyDomain(c.atmosphere.empty() ? path : c.atmosphere,
+                           AtmosphereFromJson(fit["atmosphere_parameters"].dump(),
+                                              path + ": fit.atmosphere_parameters"));
+}
+
+}  // namespace
+
 ModelInfo HosekWilkieModel::StaticInfo() {
     ModelInfo info;
     info.name = "hosek-wilkie";
@@ -165,6 +179,7 @@ ModelInfo HosekWilkieModel::StaticInfo() {
         "spectral 320-720 nm, per unit extraterrestrial solar irradiance";
     info.capabilities = FittedSkyCapabilities();
     info.capabilities.shader = "hosek_wilkie";
+    info.domain = FittedToEarthDomain();  // the published coefficients; a fitted file's below
     info.options = OptionRows().Specs();
     return info;
 }
@@ -211,6 +226,11 @@ HosekWilkieModel::HosekWilkieModel(const HosekWilkieOptions& options) : options_
             LoadHosekWilkieCoefficients(options.coefficients));
     }
     Prepare(EarthAtmosphere());
+    if (fitted_) {
+        // The file's own atmosphere (`atmos fit` records it), checked from here
+        // on; Earth's default above is not one it was fitted to.
+        info_.domain = FittedFileDomain(*fitted_, options.coefficients);
+    }
 }
 
 void HosekWilkieModel::Prepare(const AtmosphereParameters& atmosphere) {

@@ -212,4 +212,17 @@ std::vector<float> Model::SampleWide(const std::vector<SampleQuery>&) const {
     Fail("model ", Info().name, " has no wide channel batches (capability wide_channels)");
 }
 
+void Model::SetSpectralPaths(const SpectralAtmosphere&, const std::vector<double>&) {
+    Fail("model ", Info().name, " has no paths that carry many wavelengths");
+}
+
+void Model::RenderSpectralPaths(const RenderRequest&, std::vector<float>*) const {
+    Fail("model ", Info().name, " has no paths that carry many wavelengths");
+}
+
+std::vector<float> Model::SampleSpectralPaths(const std::vector<SampleQuery>&,
+                                              const MonteCarloSettings&) const {
+    Fail("model ", Info().name, " has no paths that carry many wavelengths");
+}
+
 }  // namespace atmos

@@ -84,6 +84,7 @@ ModelInfo PreethamModel::StaticInfo() {
         "fitted Perez sky (xyY from turbidity) for a ground viewer; luminance / 128 klx as "
         "radiance per unit irradiance";
     info.capabilities = FittedSkyCapabilities();
+    info.domain = FittedToEarthDomain();
     info.options = OptionRows().Specs();
     info.thesis_name = "Preetham, Shirley and Smits";
     info.thesis_lines = 58;

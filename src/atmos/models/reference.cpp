@@ -11,7 +11,9 @@
 #include <vector>
 
 #include "atmos/error.h"
+#include "atmos/spectral.h"
 #include "base/parallel.h"
+#include "render/render.h"
 
 namespace atmos {
 
@@ -47,6 +49,11 @@ double MaxProfileDensity(const DensityProfile& profile, double h0, double h1) {
 }
 
 MajorantShells BuildMajorantShells(const AtmosphereParameters& atm, int count) {
+    return BuildMajorantShells(atm, count, {});
+}
+
+MajorantShells BuildMajorantShells(const AtmosphereParameters& atm, int count,
+                                   const std::vector<HeroSpectrum>& extra) {
     MajorantShells shells;
     shells.count = std::clamp(count, 1, kMaxReferenceShells);
     const double delta = atm.top_radius - atm.bottom_radius;
@@ -65,6 +72,12 @@ MajorantShells BuildMajorantShells(const AtmosphereParameters& atm, int count) {
         for (int c = 0; c < 3; ++c) {
             bar = std::max(bar, atm.rayleigh_scattering[c] * mr + atm.mie_extinction[c] * mm +
                                     atm.absorption_extinction[c] * mo);
+        }
+        for (const HeroSpectrum& g : extra) {
+            for (int c = 0; c < g.count; ++c) {
+                bar = std::max(
+                    bar, g.rayleigh[c] * mr + g.mie_extinction[c] * mm + g.absorption[c] * mo);
+            }
         }
         // A hair above the exact maximum so rounding never makes sigma_n < 0.
         shells.majorant[k] = bar * (1.0 + 1e-9);
@@ -186,6 +199,7 @@ ModelInfo ReferenceModel::StaticInfo() {
     info.summary = "unbiased Monte Carlo: all scattering orders, planet shadow, Lambertian ground";
     info.capabilities.multiple_scattering = true;
     info.capabilities.stochastic = true;
+    info.capabilities.spectral_paths = true;  // with spectral=hero (the constructor)
     info.options = OptionRows().Specs();
     info.thesis_name = "Path tracer";
     info.thesis_lines = 147;
@@ -228,7 +242,12 @@ const OptionTable<ReferenceOptions>& ReferenceModel::OptionRows() {
                   "Henyey-Greenstein lobe around the sun at a first vertex with the sun below "
                   "its horizon (twilight; MIS with the phase function; 0: none)")
             .Real("sun-lobe-g", &O::sun_lobe_g, 0.0, 0.99, "",
-                  "hybrid: the sun lobe's Henyey-Greenstein g");
+                  "hybrid: the sun lobe's Henyey-Greenstein g")
+            .Choice("spectral", &O::hero, {{"hero", true}, {"batches", false}},
+                    "spectral runs (--wavelengths, more than three): hero: every path carries "
+                    "all the wavelengths (hero-wavelength sampling, spectral MIS; hybrid "
+                    "estimator, radiance without the sun's disc or a noise target, CPU); "
+                    "batches: a set of paths per batch of three wavelengths");
     return table;
 }
 
@@ -248,13 +267,14 @@ ReferenceModel::ReferenceModel(const ReferenceOptions& options) : info_(StaticIn
     evaluator_.sun_lobe = options.sun_lobe;
     evaluator_.sun_lobe_g = options.sun_lobe_g;
     sun_disc_light_ = options.sun_disc_light != 0;
+    info_.capabilities.spectral_paths = options.hero && hybrid;
     Prepare(EarthAtmosphere());
 }
 
 void ReferenceModel::Prepare(const AtmosphereParameters& atmosphere) {
     evaluator_.atm = atmosphere;
     evaluator_.sun_cone_cos = sun_disc_light_ ? std::cos(atmosphere.sun_angular_radius) : 1.0;
-    evaluator_.shells = BuildMajorantShells(atmosphere, shell_count_);
+    evaluator_.shells = BuildMajorantShells(atmosphere, shell_count_, hero_groups_);
     std::lock_guard<std::mutex> lock(sun_table_mutex_);
     resident_.Reset();
     sun_table_ready_ = false;
@@ -397,6 +417,127 @@ std::vector<SampleAnswer> ReferenceModel::SamplePass(const std::vector<SampleQue
     ResidentScope scope(&resident_);
     scope.Keep(e);
     return SampleAll(e, e.atm.bottom_radius, queries);
+}
+
+void ReferenceModel::SetSpectralPaths(const SpectralAtmosphere& atmosphere,
+                                      const std::vector<double>& nm) {
+    if (!info_.capabilities.spectral_paths) {
+        Fail(
+            "model reference: paths that carry many wavelengths need estimator=hybrid and "
+            "spectral=hero");
+    }
+    hero_groups_.clear();
+    Vec3d scale;
+    for (double l : nm) {
+        scale =
+            Max(scale, Vec3d(atmosphere.rayleigh_scattering.At(l), atmosphere.mie_extinction.At(l),
+                             atmosphere.absorption_extinction.At(l)));
+    }
+    for (size_t i = 0; i < nm.size(); ++i) {
+        if (i % kHeroMaxChannels == 0) {
+            hero_groups_.emplace_back();
+            hero_groups_.back().column_scale = scale;
+        }
+        HeroSpectrum& s = hero_groups_.back();
+        const int c = s.count++;
+        const double l = nm[i];
+        s.rayleigh[c] = atmosphere.rayleigh_scattering.At(l);
+        s.mie_scattering[c] = atmosphere.mie_scattering.At(l);
+        s.mie_extinction[c] = atmosphere.mie_extinction.At(l);
+        s.absorption[c] = atmosphere.absorption_extinction.At(l);
+        s.albedo[c] = atmosphere.ground_albedo.At(l);
+    }
+}
+
+namespace {
+
+// The hero evaluator of `e` for one group of channels.
+ReferenceHero HeroOf(const ReferenceEvaluator& e, const HeroSpectrum& spectrum) {
+    ReferenceHero hero;
+    static_cast<ReferenceHybrid&>(hero) = e;
+    hero.spec = spectrum;
+    hero.order1_cached = false;
+    hero.order1_table = TableView();
+    return hero;
+}
+
+}  // namespace
+
+void ReferenceModel::RenderSpectralPaths(const RenderRequest& request,
+                                         std::vector<float>* values) const {
+    if (hero_groups_.empty()) Fail("model reference: RenderSpectralPaths before SetSpectralPaths");
+    if (request.quantity != Quantity::kRadiance || request.sun_disc) {
+        Fail(
+            "model reference: paths that carry many wavelengths render radiance without the "
+            "sun's disc");
+    }
+    const PixelSetup setup = MakePixelSetup(request, evaluator_.atm);
+    size_t n = 0;
+    for (const HeroSpectrum& g : hero_groups_) n += static_cast<size_t>(g.count);
+    const size_t width = static_cast<size_t>(request.width);
+    values->assign(width * static_cast<size_t>(request.height) * n, 0.0f);
+    const int64_t spp = std::max<int64_t>(request.monte_carlo.spp, 1);
+    const double inv = 1.0 / static_cast<double>(spp);
+    size_t offset = 0;
+    for (const HeroSpectrum& group : hero_groups_) {
+        ReferenceHero hero = HeroOf(evaluator(), group);
+        hero.seed = request.monte_carlo.seed;
+        hero.sample_begin = 0;
+        hero.sample_count = spp;
+        hero.need_transmittance = false;
+        ParallelFor(request.height, 1, [&](int64_t y) {
+            double sky[kHeroMaxChannels], ground[kHeroMaxChannels];
+            for (int x = 0; x < request.width; ++x) {
+                const Vec3d dir =
+                    setup.camera.RayDirection(x, static_cast<int>(y), setup.width, setup.height);
+                if (dir.x == 0.0 && dir.y == 0.0 && dir.z == 0.0) continue;
+                const uint64_t key = static_cast<uint64_t>(y) * width + static_cast<uint64_t>(x);
+                hero.EvaluateHero(setup.camera.position, dir, setup.sun_direction, true, key, sky,
+                                  ground);
+                float* out = values->data() + (static_cast<size_t>(y) * width + x) * n + offset;
+                for (int c = 0; c < group.count; ++c) {
+                    out[c] = static_cast<float>(sky[c] * inv) + static_cast<float>(ground[c] * inv);
+                }
+            }
+        });
+        offset += static_cast<size_t>(group.count);
+    }
+    GuardOutput(values->data(), values->size());
+}
+
+std::vector<float> ReferenceModel::SampleSpectralPaths(const std::vector<SampleQuery>& queries,
+                                                       const MonteCarloSettings& mc) const {
+    if (hero_groups_.empty()) Fail("model reference: SampleSpectralPaths before SetSpectralPaths");
+    size_t n = 0;
+    for (const HeroSpectrum& g : hero_groups_) n += static_cast<size_t>(g.count);
+    std::vector<float> values(queries.size() * n, 0.0f);
+    const int64_t spp = std::max<int64_t>(mc.spp, 1);
+    const double inv = 1.0 / static_cast<double>(spp);
+    size_t offset = 0;
+    for (const HeroSpectrum& group : hero_groups_) {
+        ReferenceHero hero = HeroOf(evaluator(), group);
+        hero.seed = mc.seed;
+        hero.sample_begin = 0;
+        hero.sample_count = spp;
+        hero.need_transmittance = false;
+        ParallelFor(static_cast<int64_t>(queries.size()), 1, [&](int64_t i) {
+            const SampleQuery& q = queries[static_cast<size_t>(i)];
+            Vec3d dir, sun;
+            SampleDirections(q, &dir, &sun);
+            const Vec3d camera(0.0, 0.0, hero.atm.bottom_radius + q.altitude_m);
+            double sky[kHeroMaxChannels], ground[kHeroMaxChannels];
+            hero.EvaluateHero(camera, dir, sun, q.ground != 0, SampleQueryKey(q), sky, ground);
+            float* out = values.data() + static_cast<size_t>(i) * n + offset;
+            for (int c = 0; c < group.count; ++c) {
+                // As SampleOne: the float sky (+ the float ground).
+                out[c] = static_cast<float>(sky[c] * inv);
+                if (q.ground != 0) out[c] += static_cast<float>(ground[c] * inv);
+            }
+        });
+        offset += static_cast<size_t>(group.count);
+    }
+    GuardOutput(values.data(), values.size());
+    return values;
 }
 
 }  // namespace atmos

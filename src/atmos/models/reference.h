@@ -74,6 +74,7 @@
 #include "base/texture.h"
 #include "models/evaluator_model.h"
 #include "models/reference_common.h"
+#include "models/reference_hero.h"
 #include "models/reference_hybrid.h"
 #include "render/progressive.h"
 
@@ -155,6 +156,7 @@ struct ReferenceOptions {
     int nee_comb = 2;             // hybrid: comb points per continuation segment (twilight)
     double sun_lobe = 0.5;        // hybrid: the first direction's sun-lobe probability (twilight)
     double sun_lobe_g = 0.8;      // hybrid: its Henyey-Greenstein g
+    bool hero = true;             // spectral runs: hero-wavelength paths (else batches of three)
 };
 
 // The sun's optical-depth table of the hybrid estimator: texels along x_mu and
@@ -177,6 +179,14 @@ class ReferenceModel : public MonteCarloModel {
     std::vector<SampleAnswer> SamplePass(const std::vector<SampleQuery>& queries,
                                          const MonteCarloPass& pass) const override;
     std::string PassKey() const override;
+    // Hero-wavelength paths (reference_hero.h): all of a spectral run's
+    // wavelengths per path, in groups of at most kHeroMaxChannels.
+    void SetSpectralPaths(const SpectralAtmosphere& atmosphere,
+                          const std::vector<double>& nm) override;
+    void RenderSpectralPaths(const RenderRequest& request,
+                             std::vector<float>* values) const override;
+    std::vector<float> SampleSpectralPaths(const std::vector<SampleQuery>& queries,
+                                           const MonteCarloSettings& mc) const override;
     // The evaluator (its sun table built on first use after Prepare).
     const ReferenceEvaluator& evaluator() const;
 
@@ -197,6 +207,9 @@ class ReferenceModel : public MonteCarloModel {
     // pixel setup's numbers as the key), reused by every pass of a render.
     mutable std::shared_ptr<const Table> order1_table_;
     mutable std::vector<double> order1_key_;
+    // SetSpectralPaths' channels (empty: none); Prepare() bounds the majorants
+    // over all of them.
+    std::vector<HeroSpectrum> hero_groups_;
     int shell_count_ = 48;
     bool sun_disc_light_ = false;
 };

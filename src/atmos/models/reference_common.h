@@ -90,8 +90,12 @@ struct AdaptivePoint {
     Vec3d sigma;  // extinction
 };
 
-ATMOS_HD inline Vec3d AdaptiveOpticalDepth(const AtmosphereParameters& atm, const Vec3d& origin,
-                                           const Vec3d& dir, double length) {
+// The integral of rate(densities) along the segment by the same rule
+// (AdaptiveOpticalDepth: rate = the extinction; ReferenceHero: the scaled
+// column densities).
+template <typename Rate>
+ATMOS_HD inline Vec3d AdaptiveIntegral(const AtmosphereParameters& atm, const Vec3d& origin,
+                                       const Vec3d& dir, double length, const Rate& rate) {
     if (!(length > 0.0)) return Vec3d(0.0);
     double cuts[3] = {0.0, length, length};
     int nc = 2;
@@ -114,8 +118,7 @@ ATMOS_HD inline Vec3d AdaptiveOpticalDepth(const AtmosphereParameters& atm, cons
                 q.t = b - span * (1.0 - u) * (1.0 - u);
                 q.jac = 2.0 * span * (1.0 - u);
             }
-            q.sigma =
-                Extinction(atm, GetDensities(atm, Length(origin + dir * q.t) - atm.bottom_radius));
+            q.sigma = rate(GetDensities(atm, Length(origin + dir * q.t) - atm.bottom_radius));
             return q;
         };
         struct Panel {
@@ -176,6 +179,16 @@ ATMOS_HD inline Vec3d AdaptiveOpticalDepth(const AtmosphereParameters& atm, cons
     return tau;
 }
 
+struct ExtinctionRate {
+    const AtmosphereParameters* atm;
+    ATMOS_HD Vec3d operator()(const Densities& d) const { return Extinction(*atm, d); }
+};
+
+ATMOS_HD inline Vec3d AdaptiveOpticalDepth(const AtmosphereParameters& atm, const Vec3d& origin,
+                                           const Vec3d& dir, double length) {
+    return AdaptiveIntegral(atm, origin, dir, length, ExtinctionRate{&atm});
+}
+
 // The sun's transmittance from a point (r, mu_s) to space: 0 when the ray meets
 // the ground (exact geometry), else exp(-tau) with tau = beta_R c_R + beta_M,ext
 // c_M + beta_A c_A, the column densities c (m, density x length) bilinear in a
@@ -207,7 +220,15 @@ struct SunTransmittanceTable {
     }
 
     ATMOS_HD Vec3d Lookup(double r, double mu) const {
-        if (RayIntersectsGround(r, mu, bottom)) return Vec3d(0.0);
+        Vec3d c;
+        if (!Columns(r, mu, &c)) return Vec3d(0.0);
+        return Exp(-(rayleigh * c.x + mie_extinction * c.y + absorption * c.z));
+    }
+
+    // The table's Rayleigh, Mie and absorption columns (m) from (r, mu) to
+    // the top boundary; false where the ray meets the ground.
+    ATMOS_HD bool Columns(double r, double mu, Vec3d* column) const {
+        if (RayIntersectsGround(r, mu, bottom)) return false;
         r = Clamp(r, bottom, top);
         const double H = Sqrt(top * top - bottom * bottom);
         const double rho = SafeSqrt(r * r - bottom * bottom);
@@ -218,9 +239,9 @@ struct SunTransmittanceTable {
         const double x_r = rho / H;
         const Vec4f v = columns.SampleBilinear(GetTextureCoordFromUnitRange(x_mu, columns.width),
                                                GetTextureCoordFromUnitRange(x_r, columns.height));
-        return Exp(-(rayleigh * static_cast<double>(v.x) +
-                     mie_extinction * static_cast<double>(v.y) +
-                     absorption * static_cast<double>(v.z)));
+        *column =
+            Vec3d(static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z));
+        return true;
     }
 };
 

@@ -75,6 +75,10 @@ struct ReferenceHybrid : ReferenceBaseline {
         // Build-time only: dt/du, Rayleigh and Mie densities, sun transmittance.
         double jac, rho_r, rho_m;
         Vec3d sun_t;
+        // The Rayleigh, Mie and absorption densities at the node and their
+        // columns from the segment's start (m), by the rules of tau (which is
+        // linear in them: the hero paths' optical depth at any wavelength).
+        Vec3d rho, column;
     };
 
     // A monotonic piece [a, b] of the view segment: t = a + span u^2 from its
@@ -115,6 +119,8 @@ struct ReferenceHybrid : ReferenceBaseline {
         node.jac = jac;
         node.rho_r = d.rayleigh;
         node.rho_m = d.mie;
+        node.rho = Vec3d(d.rayleigh, d.mie, d.absorption);
+        node.column = Vec3d(0.0);
         // The sun's transmittance just inside the piece at its ends (it
         // jumps at a shadow crossing: each piece takes its side).
         const double ts = j == 0 ? t + 1e-7 * pc.span : (j == denom ? t - 1e-7 * pc.span : t);
@@ -338,10 +344,18 @@ struct ReferenceHybrid : ReferenceBaseline {
                     end.tau = s.tau + (s.sigma_t * start_jac + mid.sigma_t * (4.0 * mid.jac) +
                                        end.sigma_t * end.jac) *
                                           (h / 3.0);
+                    mid.column = s.column + (s.rho * (5.0 * start_jac) + mid.rho * (8.0 * mid.jac) -
+                                             end.rho * end.jac) *
+                                                (h / 12.0);
+                    end.column = s.column + (s.rho * start_jac + mid.rho * (4.0 * mid.jac) +
+                                             end.rho * end.jac) *
+                                                (h / 3.0);
                     // Optical depth never decreases (the 3-point rule can
                     // undershoot where the extinction rises steeply).
                     mid.tau = Max(mid.tau, s.tau);
                     end.tau = Max(end.tau, mid.tau);
+                    mid.column = Max(mid.column, s.column);
+                    end.column = Max(end.column, mid.column);
                     mass(s, &mid);
                     mass(mid, &end);
                     if (with_order1) {
@@ -515,7 +529,8 @@ struct ReferenceHybrid : ReferenceBaseline {
         if (length > 0.0) {
             count = BuildViewTable(start, dir, sun, length, nodes, &order1, !order1_cached);
         } else {
-            nodes[0] = {0.0, Vec3d(0.0), Vec3d(0.0), 0.0, 0.0, 0.0, 0.0, Vec3d(0.0)};
+            nodes[0] = {0.0, Vec3d(0.0), Vec3d(0.0), 0.0,        0.0,
+                        0.0, 0.0,        Vec3d(0.0), Vec3d(0.0), Vec3d(0.0)};
         }
         const Vec3d tau_end = nodes[count - 1].tau;
         *tau_out = tau_end;

@@ -18,7 +18,45 @@ std::string Number(double value) {
     return buf;
 }
 
+bool Differs(double a, double b, double rel) {
+    return std::abs(a - b) > rel * std::max({std::abs(a), std::abs(b), 1e-300});
+}
+
+void CompareProfile(const char* name, const DensityProfile& a, const DensityProfile& b, double rel,
+                    std::vector<std::string>* out) {
+    for (int i = 0; i < 2; ++i) {
+        const DensityProfileLayer& x = a.layers[i];
+        const DensityProfileLayer& y = b.layers[i];
+        const struct {
+            const char* field;
+            double value, fit;
+        } fields[] = {{"width", x.width, y.width},
+                      {"exp_term", x.exp_term, y.exp_term},
+                      {"exp_scale", x.exp_scale, y.exp_scale},
+                      {"linear_term", x.linear_term, y.linear_term},
+                      {"constant_term", x.constant_term, y.constant_term}};
+        for (const auto& f : fields) {
+            if (i == 1 && std::string(f.field) == "width") continue;  // ignored (atmosphere.h)
+            if (Differs(f.value, f.fit, rel)) {
+                out->push_back(std::string(name) + ".layers[" + std::to_string(i) + "]." + f.field +
+                               " " + Number(f.value) + " (fit: " + Number(f.fit) + ")");
+            }
+        }
+    }
+}
+
 }  // namespace
+
+std::vector<std::string> AtmosphereShapeDifferences(const AtmosphereParameters& a,
+                                                    const AtmosphereParameters& fit) {
+    std::vector<std::string> out;
+    if (Differs(a.bottom_radius, fit.bottom_radius, 0.02)) {
+        out.push_back("bottom_radius " + Number(a.bottom_radius) +
+                      " (fit: " + Number(fit.bottom_radius) + ")");
+    }
+    CompareProfile("rayleigh_density", a.rayleigh_density, fit.rayleigh_density, 0.1, &out);
+    return out;
+}
 
 double VerticalOpticalDepth(const AtmosphereParameters& a) {
     const double thickness = a.top_radius - a.bottom_radius;
@@ -51,9 +89,22 @@ std::vector<std::string> ValidityDomainViolations(const ModelInfo& info,
                                                   const AtmosphereParameters& atmosphere) {
     const ValidityDomain& d = info.domain;
     std::vector<std::string> out;
+    if (d.fitted_atmosphere) {
+        const std::vector<std::string> diffs =
+            AtmosphereShapeDifferences(atmosphere, *d.fitted_atmosphere);
+        if (!diffs.empty()) {
+            std::string text = "its sky is a fit to the atmosphere '" + d.fitted_to +
+                               "' and does not follow this one's (";
+            for (size_t i = 0; i < diffs.size() && i < 3; ++i) {
+                text += (i ? ", " : "") + diffs[i];
+            }
+            if (diffs.size() > 3) text += ", and " + std::to_string(diffs.size() - 3) + " more";
+            out.push_back(text + ")");
+        }
+    }
     if (d.max_radius_ratio <= 0.0 && d.max_shell_heights <= 0.0 && d.max_radius_heights <= 0.0 &&
         d.max_optical_depth <= 0.0) {
-        return out;  // nothing declared: nothing to measure
+        return out;  // no limit declared: nothing to measure
     }
     const double bottom = atmosphere.bottom_radius, top = atmosphere.top_radius;
     const double height = ColumnEquivalentHeight(atmosphere);

@@ -33,36 +33,56 @@ ATMOS_HD inline double CornetteShanksPhase(double g, double nu) {
     return k * (1.0 + nu * nu) / (denom * Sqrt(denom));
 }
 
-// The Mie phase function of an atmosphere: one Cornette-Shanks lobe, or two,
-// (1 - w) CS(g, nu) + w CS(g2, nu) (AtmosphereParameters::mie_phase_weight2).
-// A convex combination of normalised lobes, so normalised. With w = 0 it is
-// CS(g, nu) exactly (the second lobe is not evaluated).
-ATMOS_HD inline double MiePhase(double g, double g2, double w, double nu) {
-    const double p = CornetteShanksPhase(g, nu);
-    if (w == 0.0) return p;
-    return (1.0 - w) * p + w * CornetteShanksPhase(g2, nu);
-}
-
 ATMOS_HD inline double HenyeyGreensteinPhase(double g, double nu) {
     const double denom = 1.0 + g * g - 2.0 * g * nu;
     return (1.0 - g * g) / (4.0 * kPi * denom * Sqrt(denom));
 }
 
+// One lobe of a lobed Mie phase function: Henyey-Greenstein for that kind,
+// Cornette-Shanks otherwise.
+ATMOS_HD inline double MieLobe(MiePhaseKind kind, double g, double nu) {
+    return kind == MiePhaseKind::kHenyeyGreenstein ? HenyeyGreensteinPhase(g, nu)
+                                                   : CornetteShanksPhase(g, nu);
+}
+
+// A lobed Mie phase function, one lobe or two: (1 - w) P(g, nu) + w P(g2, nu)
+// (AtmosphereParameters::mie_phase_weight2). A convex combination of
+// normalised lobes, so normalised. With w = 0 it is P(g, nu) exactly (the
+// second lobe is not evaluated).
+ATMOS_HD inline double MieLobes(MiePhaseKind kind, double g, double g2, double w, double nu) {
+    const double p = MieLobe(kind, g, nu);
+    if (w == 0.0) return p;
+    return (1.0 - w) * p + w * MieLobe(kind, g2, nu);
+}
+
+// The Cornette-Shanks form: one lobe or two.
+ATMOS_HD inline double MiePhase(double g, double g2, double w, double nu) {
+    return MieLobes(MiePhaseKind::kCornetteShanks, g, g2, w, nu);
+}
+
 ATMOS_HD inline double IsotropicPhase() { return 1.0 / (4.0 * kPi); }
 
-// The interval of a tabulated phase function that holds nu: the i with
-// mu[i] >= nu >= mu[i + 1] (0 <= i <= count - 2; mu decreases from 1 to -1).
-ATMOS_HD inline int MiePhaseTableInterval(const MiePhaseTable& t, double nu) {
-    int lo = 0, hi = t.count - 1;  // mu[lo] >= nu >= mu[hi]
+// Bisection over n >= 2 nodes: the i (0 <= i <= n - 2) with left(i) true and
+// left(i + 1) false, for a predicate that holds at node 0 and, once false,
+// stays false (left(n - 1) is taken as false).
+template <typename LeftOf>
+ATMOS_HD inline int BisectInterval(int n, const LeftOf& left) {
+    int lo = 0, hi = n - 1;
     while (hi - lo > 1) {
         const int mid = (lo + hi) / 2;
-        if (t.mu[mid] >= nu) {
+        if (left(mid)) {
             lo = mid;
         } else {
             hi = mid;
         }
     }
     return lo;
+}
+
+// The interval of a tabulated phase function that holds nu: the i with
+// mu[i] >= nu >= mu[i + 1] (0 <= i <= count - 2; mu decreases from 1 to -1).
+ATMOS_HD inline int MiePhaseTableInterval(const MiePhaseTable& t, double nu) {
+    return BisectInterval(t.count, [&](int i) { return t.mu[i] >= nu; });
 }
 
 // A tabulated phase function (atmosphere.h MiePhaseTable): the values linear in
@@ -81,18 +101,14 @@ ATMOS_HD inline double TabulatedPhase(const MiePhaseTable& t, double nu) {
 ATMOS_HD inline double MiePhase(MiePhaseKind kind, double g, double g2, double w,
                                 const MiePhaseTable& table, double nu) {
     switch (kind) {
-        case MiePhaseKind::kHenyeyGreenstein: {
-            const double p = HenyeyGreensteinPhase(g, nu);
-            if (w == 0.0) return p;
-            return (1.0 - w) * p + w * HenyeyGreensteinPhase(g2, nu);
-        }
         case MiePhaseKind::kIsotropic:
             return IsotropicPhase();
         case MiePhaseKind::kTabulated:
             return TabulatedPhase(table, nu);
+        case MiePhaseKind::kHenyeyGreenstein:
         case MiePhaseKind::kCornetteShanks:
         default:
-            return MiePhase(g, g2, w, nu);
+            return MieLobes(kind, g, g2, w, nu);
     }
 }
 

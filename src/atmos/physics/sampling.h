@@ -44,15 +44,7 @@ ATMOS_HD inline double CornetteShanksOverHenyeyGreenstein(double g, double mu) {
 // k = (v_{i+1} - v_i) / (2 h) (the form without cancellation; v > 0 keeps the root real).
 // The density of the result is TabulatedPhase itself.
 ATMOS_HD inline double SampleTabulatedPhaseCosine(const MiePhaseTable& t, double xi) {
-    int lo = 0, hi = t.count - 1;  // cdf[lo] <= xi < cdf[hi]
-    while (hi - lo > 1) {
-        const int mid = (lo + hi) / 2;
-        if (t.cdf[mid] <= xi) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
+    const int lo = BisectInterval(t.count, [&](int i) { return t.cdf[i] <= xi; });
     const double h = t.mu[lo] - t.mu[lo + 1];
     const double v0 = t.value[lo];
     const double k = (t.value[lo + 1] - v0) / (2.0 * h);
