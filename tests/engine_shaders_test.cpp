@@ -197,7 +197,7 @@ TEST(EngineShaders, EveryPrecomputePassCompiles) {
         }
         EXPECT_EQ(entries.size(), c.entries) << options;
         for (const std::string& entry : entries) {
-            for (const std::string version : {std::string("330 core"), std::string("300 es")}) {
+            for (const std::string& version : {std::string("330 core"), std::string("300 es")}) {
                 const std::string precision = version == "300 es"
                                                   ? "precision highp float;\nprecision highp "
                                                     "int;\nprecision highp sampler3D;\n"

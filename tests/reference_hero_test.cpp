@@ -206,7 +206,7 @@ TEST(ReferenceHero, SameAnswerOnOneAndTwoThreads) {
     ASSERT_EQ(one.size(), two.size());
     EXPECT_EQ(one, two);
     double sum = 0.0;
-    for (float v : one) sum += v;
+    for (float v : one) sum += static_cast<double>(v);
     EXPECT_GT(sum, 0.0);
 }
 
