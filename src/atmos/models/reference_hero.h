@@ -128,44 +128,25 @@ struct ReferenceHero : ReferenceHybrid {
         const int n = spec.count;
         int shell = shells.ShellOf(Length(p));
         const double k = continuation_majorant_scale;
-        Vec3d origin = p;
-        double travelled = 0.0, seg_length = 0.0, comb = 0.0;
-        double comb_t[kMaxNeeComb];
-        int comb_n = 0, comb_next = 0;
+        CombSegment seg;
         bool new_segment = true;
         for (int guard = 0; guard < 1000000; ++guard) {
             if (new_segment) {
                 new_segment = false;
-                origin = p;
-                travelled = 0.0;
-                comb_n = comb_next = 0;
-                comb = 0.0;
-                if (nee_comb > 0 && Dot(p, sun) < 0.0) {
-                    const double r = Length(p);
-                    const double mu = ClampCosine(Dot(p, dir) / r);
-                    seg_length = RayIntersectsGround(r, mu, atm.bottom_radius)
-                                     ? DistanceToBottomAtmosphereBoundary(r, mu, atm.bottom_radius)
-                                     : DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius);
-                    if (seg_length > 0.0) {
-                        comb_n = Min(nee_comb, kMaxNeeComb);
-                        comb = comb_n / seg_length;
-                        for (int j = 0; j < comb_n; ++j) {
-                            comb_t[j] = seg_length * (j + rng.Uniform()) / comb_n;
-                        }
-                    }
-                }
+                BeginCombSegment(p, dir, sun, rng, &seg);
             }
-            const Step step = Track(&p, dir, &shell, rng, k, &travelled);
+            const Step step = Track(&p, dir, &shell, rng, k, &seg.travelled);
             const bool light = max_order == 0 || order < max_order;
-            const double reached = step == Step::kCollision ? travelled : seg_length;
-            for (; comb_next < comb_n && comb_t[comb_next] <= reached; ++comb_next) {
+            const double reached = step == Step::kCollision ? seg.travelled : seg.length;
+            for (; seg.next < seg.n && seg.t[seg.next] <= reached; ++seg.next) {
                 if (!light) continue;
-                const Vec3d q = origin + dir * comb_t[comb_next];
+                const Vec3d q = seg.origin + dir * seg.t[seg.next];
                 const double r = Length(q);
                 const Densities d = GetDensities(atm, r - atm.bottom_radius);
                 const double sigma_bar =
                     continuation_majorant_scale * shells.majorant[shells.ShellOf(r)];
-                AddInScatter(q, d, Dot(dir, sun), sun, w, 1.0 / (sigma_bar + comb), radiance);
+                AddInScatter(q, d, Dot(dir, sun), sun, w, 1.0 / (sigma_bar + seg.intensity),
+                             radiance);
             }
             if (step == Step::kEscaped) break;
             double max_w = 0.0;
@@ -207,7 +188,8 @@ struct ReferenceHero : ReferenceHybrid {
                 const double total = a_r + a_m + a_n;
                 if (!(total > 0.0)) break;
                 if (light) {
-                    AddInScatter(p, d, Dot(dir, sun), sun, w, 1.0 / (sigma_bar + comb), radiance);
+                    AddInScatter(p, d, Dot(dir, sun), sun, w, 1.0 / (sigma_bar + seg.intensity),
+                                 radiance);
                 }
                 // The event by the throughput-weighted sums (ChooseEvent).
                 const double xi = rng.Uniform() * total;

@@ -377,6 +377,40 @@ struct ReferenceHybrid : ReferenceBaseline {
         return count;
     }
 
+    // A segment of a continued path (HybridContinue, ReferenceHero): its
+    // origin, the distance moved along it, its length, and the next-event
+    // comb's intensity and points (sorted; `next` the first not yet passed).
+    struct CombSegment {
+        Vec3d origin;
+        double travelled = 0.0, length = 0.0, intensity = 0.0;
+        double t[kMaxNeeComb];
+        int n = 0, next = 0;
+    };
+
+    // Starts a segment at p along dir. The comb only where the sun is below
+    // the origin's horizon (twilight: the lit air is thin and far); a choice by
+    // the segment's origin alone, so both strategies stay unbiased. `length`
+    // is set only with a comb (without one nothing reads it).
+    ATMOS_HD void BeginCombSegment(const Vec3d& p, const Vec3d& dir, const Vec3d& sun, Rng& rng,
+                                   CombSegment* s) const {
+        s->origin = p;
+        s->travelled = 0.0;
+        s->n = s->next = 0;
+        s->intensity = 0.0;
+        if (nee_comb > 0 && Dot(p, sun) < 0.0) {
+            const double r = Length(p);
+            const double mu = ClampCosine(Dot(p, dir) / r);
+            s->length = RayIntersectsGround(r, mu, atm.bottom_radius)
+                            ? DistanceToBottomAtmosphereBoundary(r, mu, atm.bottom_radius)
+                            : DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius);
+            if (s->length > 0.0) {
+                s->n = Min(nee_comb, kMaxNeeComb);
+                s->intensity = s->n / s->length;
+                for (int j = 0; j < s->n; ++j) s->t[j] = s->length * (j + rng.Uniform()) / s->n;
+            }
+        }
+    }
+
     // Continues a path from a real vertex (direction already sampled): adds
     // every next-event estimate (orders >= order + 1) to *radiance.
     //
@@ -396,45 +430,22 @@ struct ReferenceHybrid : ReferenceBaseline {
                                  Vec3d* radiance) const {
         int shell = shells.ShellOf(Length(p));
         const double k = continuation_majorant_scale;
-        // The segment being tracked: its origin, the distance moved along it,
-        // its length, the comb's intensity and points.
-        Vec3d origin = p;
-        double travelled = 0.0, seg_length = 0.0, comb = 0.0;
-        double comb_t[kMaxNeeComb];
-        int comb_n = 0, comb_next = 0;
+        // The segment being tracked, with its next-event comb.
+        CombSegment seg;
         bool new_segment = true;
         for (int guard = 0; guard < 1000000; ++guard) {
             if (new_segment) {
                 new_segment = false;
-                origin = p;
-                travelled = 0.0;
-                comb_n = comb_next = 0;
-                comb = 0.0;
-                // Only where the sun is below the origin's horizon (twilight:
-                // the lit air is thin and far); a choice by the segment's
-                // origin alone, so both strategies stay unbiased.
-                if (nee_comb > 0 && Dot(p, sun) < 0.0) {
-                    const double r = Length(p);
-                    const double mu = ClampCosine(Dot(p, dir) / r);
-                    seg_length = RayIntersectsGround(r, mu, atm.bottom_radius)
-                                     ? DistanceToBottomAtmosphereBoundary(r, mu, atm.bottom_radius)
-                                     : DistanceToTopAtmosphereBoundary(r, mu, atm.top_radius);
-                    if (seg_length > 0.0) {
-                        comb_n = Min(nee_comb, kMaxNeeComb);
-                        comb = comb_n / seg_length;
-                        for (int j = 0; j < comb_n; ++j) {
-                            comb_t[j] = seg_length * (j + rng.Uniform()) / comb_n;
-                        }
-                    }
-                }
+                BeginCombSegment(p, dir, sun, rng, &seg);
             }
-            const Step step = Track(&p, dir, &shell, rng, k, &travelled);
+            const Step step = Track(&p, dir, &shell, rng, k, &seg.travelled);
             const bool light = max_order == 0 || order < max_order;
             // The comb's points the path has passed (all, once it leaves the segment).
-            const double reached = step == Step::kCollision ? travelled : seg_length;
-            for (; comb_next < comb_n && comb_t[comb_next] <= reached; ++comb_next) {
+            const double reached = step == Step::kCollision ? seg.travelled : seg.length;
+            for (; seg.next < seg.n && seg.t[seg.next] <= reached; ++seg.next) {
                 if (light)
-                    *radiance += w * CombEstimate(origin + dir * comb_t[comb_next], dir, sun, comb);
+                    *radiance += w * CombEstimate(seg.origin + dir * seg.t[seg.next], dir, sun,
+                                                  seg.intensity);
             }
             if (step == Step::kEscaped) break;
             if (step == Step::kGround) {
@@ -458,8 +469,8 @@ struct ReferenceHybrid : ReferenceBaseline {
                 if (light) {
                     const Vec3d scatter = InScatter(c.sigma_r, c.sigma_m, Dot(dir, sun));
                     if (MaxComponent(w * scatter) > 0.0) {
-                        *radiance +=
-                            w * scatter * (1.0 / (c.sigma_bar + comb)) * SunTransmittanceAt(p, sun);
+                        *radiance += w * scatter * (1.0 / (c.sigma_bar + seg.intensity)) *
+                                     SunTransmittanceAt(p, sun);
                     }
                 }
                 const Event event = ChooseEvent(c, rng, &w);
