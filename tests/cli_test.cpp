@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <csignal>
 #include <cstdint>
@@ -617,10 +618,21 @@ TEST(Cli, SampleWavelengthsAddsSpectralColumns) {
     std::getline(lines, row);
     EXPECT_EQ(header, "altitude_m,mu,mu_s,azimuth_deg,L_360,L_371.75,X,Y,Z");
     std::vector<double> v;
+    std::vector<std::string> texts;
     std::stringstream fields(row);
     std::string f;
-    while (std::getline(fields, f, ',')) v.push_back(std::stod(f));
+    while (std::getline(fields, f, ',')) {
+        v.push_back(std::stod(f));
+        texts.push_back(f);
+    }
     ASSERT_EQ(v.size(), 9u) << row;
+    // Each answer (L, X, Y, Z) is its float's shortest round-trip text.
+    for (size_t i = 4; i < texts.size(); ++i) {
+        char shortest[64];
+        const std::to_chars_result c = std::to_chars(
+            shortest, shortest + sizeof shortest, std::stof(texts[i]), std::chars_format::general);
+        EXPECT_EQ(texts[i], std::string(shortest, c.ptr)) << i;
+    }
     // Spectral radiance of a clear sky at 360 nm: of the order of 0.05 W m^-2 sr^-1 nm^-1.
     EXPECT_GT(v[4], 0.01);
     EXPECT_LT(v[4], 0.5);
@@ -638,7 +650,7 @@ TEST(Cli, SampleWavelengthsAddsSpectralColumns) {
     const atmos::detail::NpyArray array = atmos::detail::ReadNpyArray(npy.string());
     ASSERT_EQ(array.shape, (std::vector<std::uint64_t>{1, 5}));
     for (size_t i = 0; i < 5; ++i) {
-        EXPECT_NEAR(array.values[i], v[i + 4], 1e-6 * std::abs(v[i + 4])) << i;
+        EXPECT_EQ(array.values[i], std::stof(texts[i + 4])) << i;  // the same floats
     }
     ExpectError("sample -m naive --wavelengths 700:400:3", "--wavelengths", in);
     ExpectError("sample -m neural --wavelengths 400:700:4", "per-wavelength", in);

@@ -102,6 +102,12 @@ Vec3d Cie1931(double nm);
 // XYZ of a spectrum sampled at `nm` with `weights`: sum_i S_i cmf(nm_i) w_i.
 Vec3d SpectrumToXyz(const std::vector<double>& nm, const std::vector<double>& weights,
                     const double* values, size_t stride = 1);
+// Cie1931 at each of `nm`: for many spectra at the same wavelengths, the
+// colour-matching functions interpolated once (the form below gives the same
+// bits as the one above).
+std::vector<Vec3d> Cie1931At(const std::vector<double>& nm);
+Vec3d SpectrumToXyz(const std::vector<Vec3d>& cmf, const std::vector<double>& weights,
+                    const double* values, size_t stride = 1);
 
 // The integral of the CIE 1931 y function over its table, 360-830 nm (106.86 nm).
 double CieYIntegral();

@@ -366,11 +366,12 @@ Image SpectralToColour(const SpectralImage& image, ColourOutput colour, WhitePoi
     std::vector<double> weights = WavelengthWeights(image.nm);
     const double y_integral = CieYIntegral();
     for (double& w : weights) w /= y_integral;
+    const std::vector<Vec3d> cmf = Cie1931At(image.nm);
     std::vector<double> spectrum(n);
     const size_t pixels = static_cast<size_t>(image.width) * image.height;
     for (size_t p = 0; p < pixels; ++p) {
         for (size_t i = 0; i < n; ++i) spectrum[i] = image.values[p * n + i];
-        Vec3d c = SpectrumToXyz(image.nm, weights, spectrum.data());
+        Vec3d c = SpectrumToXyz(cmf, weights, spectrum.data());
         if (colour == ColourOutput::kSrgb) c = XyzToLinearSrgb(c, white);
         for (int k = 0; k < 3; ++k) {
             // Out-of-gamut sRGB (negative) is clipped to 0: pixels are never negative.

@@ -306,15 +306,25 @@ Vec3d Cie1931(double nm) {
                  Interpolate(c.nm, c.z, nm));
 }
 
-Vec3d SpectrumToXyz(const std::vector<double>& nm, const std::vector<double>& weights,
+std::vector<Vec3d> Cie1931At(const std::vector<double>& nm) {
+    std::vector<Vec3d> cmf(nm.size());
+    for (size_t i = 0; i < nm.size(); ++i) cmf[i] = Cie1931(nm[i]);
+    return cmf;
+}
+
+Vec3d SpectrumToXyz(const std::vector<Vec3d>& cmf, const std::vector<double>& weights,
                     const double* values, size_t stride) {
     Vec3d xyz(0.0);
-    for (size_t i = 0; i < nm.size(); ++i) {
-        const Vec3d cmf = Cie1931(nm[i]);
+    for (size_t i = 0; i < cmf.size(); ++i) {
         const double s = values[i * stride] * weights[i];
-        xyz = Vec3d(xyz.x + s * cmf.x, xyz.y + s * cmf.y, xyz.z + s * cmf.z);
+        xyz = Vec3d(xyz.x + s * cmf[i].x, xyz.y + s * cmf[i].y, xyz.z + s * cmf[i].z);
     }
     return xyz;
+}
+
+Vec3d SpectrumToXyz(const std::vector<double>& nm, const std::vector<double>& weights,
+                    const double* values, size_t stride) {
+    return SpectrumToXyz(Cie1931At(nm), weights, values, stride);
 }
 
 double CieYIntegral() {
