@@ -330,6 +330,17 @@ def main():
     ap.add_argument("--save-peaks", help="write the measured peaks to this JSON")
     args = ap.parse_args()
 
+    given = []
+    for t in args.time:
+        parts = t.split(":")
+        if len(parts) < 3 or parts[0] not in MODELS:
+            sys.exit("roofline_cpu.py: error: --time %r: want MODEL:CHANNELS:NS[:LABEL] with "
+                     "MODEL in %s" % (t, ",".join(MODELS)))
+        if int(parts[1]) < 1 or float(parts[2]) <= 0:
+            sys.exit("roofline_cpu.py: error: --time %r: CHANNELS >= 1 and NS > 0" % t)
+        given.append((parts[0], int(parts[1]), float(parts[2]),
+                     parts[3] if len(parts) > 3 else "given"))
+
     sizes = [int(s) for s in args.sizes.split(",")]
     if args.peaks:
         with open(args.peaks) as f:
@@ -376,16 +387,7 @@ def main():
         for m, ns in read_costs(args.costs).items():
             if m in MODELS:
                 rows.append((m, 3, ns, "RGB, query_cost.py minus empty"))
-    for t in args.time:
-        parts = t.split(":")
-        if len(parts) < 3 or parts[0] not in MODELS:
-            sys.exit("roofline_cpu.py: error: --time %r: want MODEL:CHANNELS:NS[:LABEL] with "
-                     "MODEL in %s" % (t, ",".join(MODELS)))
-        if int(parts[1]) < 1 or float(parts[2]) <= 0:
-            sys.exit("roofline_cpu.py: error: --time %r: CHANNELS >= 1 and NS > 0" % t)
-        rows.append((parts[0], int(parts[1]), float(parts[2]),
-                     parts[3] if len(parts) > 3 else "given"))
-
+    rows += given
     print("\n## Per query, one thread (double vector FMA peak %.1f GFLOP/s, scalar double %.1f;"
           " read %s)\n" % (vec_peak / 1e9, scalar_peak / 1e9,
                            ", ".join("%s %.1f GB/s" % (k, v / 1e9) for k, v in bw.items())))
