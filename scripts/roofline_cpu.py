@@ -304,12 +304,15 @@ def measure_peaks(threads, sizes, reps, iters):
     return [json.loads(l) for l in out.splitlines() if l.startswith("{")]
 
 
-def read_costs(path):
+def read_costs(path, instructions):
+    """ns per query minus `empty`'s; fills instructions[model] (lookup_instructions)."""
     ns = {}
     with open(path, newline="") as f:
         for r in csv.DictReader(f):
             if r["kind"] == "query" and r["metric"] == "ns_per_query":
                 ns[r["model"]] = float(r["value"])
+            if r["kind"] == "query" and r["metric"] == "lookup_instructions":
+                instructions[r["model"]] = float(r["value"])
     if "empty" not in ns:
         sys.exit("roofline_cpu.py: error: --costs %s has no `empty` row (the I/O to subtract)"
                  % path)
@@ -382,9 +385,12 @@ def main():
         if hits:
             lat[level] = hits[0]["seconds"]
 
+    # The clock, from the 512-bit double FMA rate (2 FMA units x 8 lanes x 2 FLOPs).
+    ghz = next((p["per_s"] for p in one if p.get("what") == "double 512-bit"), 0.0) / 32e9
     rows = []
+    instructions = {}
     if args.costs:
-        for m, ns in read_costs(args.costs).items():
+        for m, ns in read_costs(args.costs, instructions).items():
             if m in MODELS:
                 rows.append((m, 3, ns, "RGB, query_cost.py minus empty"))
     rows += given
@@ -393,8 +399,8 @@ def main():
                            ", ".join("%s %.1f GB/s" % (k, v / 1e9) for k, v in bw.items())))
     print("| model | channels | time | FLOPs | bytes (lines) | level | compute limit | "
           "memory limit | limit | atmos / limit | atmos / (FLOPs at scalar peak) | "
-          "atmos / (lines x latency) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "atmos / (lines x latency) | instructions (IPC) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for m, n, ns, label in rows:
         model, level = MODELS[m]
         flops, useful, line_bytes = model(n)
@@ -403,10 +409,13 @@ def main():
         limit = max(t_flop, t_mem)
         serial = line_bytes / 64 * lat[level] * 1e9 if level and level in lat else 0.0
         print("| %s (%s) | %d | %.0f ns | %d | %d (%d) | %s | %.1f ns | %.1f ns | %.1f ns | "
-              "**%.0fx** | %.1fx | %s |"
+              "**%.0fx** | %.1fx | %s | %s |"
               % (m, label, n, ns, flops, useful, line_bytes, level or "-", t_flop, t_mem, limit,
                  ns / limit, ns / (flops / scalar_peak * 1e9),
-                 "%.2fx" % (ns / serial) if serial else "-"))
+                 "%.2fx" % (ns / serial) if serial else "-",
+                 "%d (%.1f)" % (instructions[m], instructions[m] / (ns * ghz))
+                 if m in instructions and label.startswith("RGB, query_cost") and ghz else "-"))
+    print("\n(IPC at %.2f GHz, the clock the 512-bit FMA rate implies.)" % ghz)
 
 
 if __name__ == "__main__":
