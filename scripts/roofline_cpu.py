@@ -308,7 +308,11 @@ def read_costs(path, instructions):
     """ns per query minus `empty`'s; fills instructions[model] (lookup_instructions)."""
     ns = {}
     with open(path, newline="") as f:
-        for r in csv.DictReader(f):
+        reader = csv.DictReader(f)
+        if not {"kind", "model", "metric", "value"} <= set(reader.fieldnames or []):
+            sys.exit("roofline_cpu.py: error: --costs %s is not bench/query_cost.py's CSV "
+                     "(columns kind, model, metric, value)" % path)
+        for r in reader:
             if r["kind"] == "query" and r["metric"] == "ns_per_query":
                 ns[r["model"]] = float(r["value"])
             if r["kind"] == "query" and r["metric"] == "lookup_instructions":
