@@ -311,15 +311,9 @@ struct ReferenceHero : ReferenceHybrid {
                 continue;
             }
             const double u = rng.Uniform() * mass;
-            int lo = 0, hi = count - 1;
-            while (hi - lo > 1) {
-                const int mid = (lo + hi) / 2;
-                if (nodes[mid].cdf <= u) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
+            // nodes[lo].cdf <= u < nodes[hi].cdf
+            const int lo = BisectInterval(count, [&](int i) { return nodes[i].cdf <= u; });
+            const int hi = Min(lo + 1, count - 1);
             const ViewNode& a = nodes[lo];
             const ViewNode& b = nodes[hi];
             const double width = b.t - a.t;
