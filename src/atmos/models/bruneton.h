@@ -691,24 +691,35 @@ struct BrunetonLut {
     // Single Mie scattering (without the phase function) between the camera at
     // (r, mu, mu_s, nu) and the point at distance d: the midpoint rule in
     // cfg.low_sun_mie_steps samples, the view ray's transmittance from the
-    // extinction accumulated along the segment, the sun's from the table
-    // (GetTransmittanceToSun, as in the precomputed single scattering).
+    // optical depths of the constituents accumulated along the segment (each
+    // channel's from them), the sun's from the table (GetTransmittanceToSun,
+    // as in the precomputed single scattering). The exponential is ExpLaneF
+    // (physics/vector_exp.h, float, within 2 ulp), which the wide evaluator
+    // runs as one vector loop over its channels.
     ATMOS_HD Rgb SegmentSingleMie(double r, double mu, double mu_s, double nu, double d) const {
         const int n = cfg.low_sun_mie_steps;
         const double dt = d / n;
-        Vec3d tau;
+        double depth_r = 0.0, depth_m = 0.0, depth_o = 0.0;
         Vec3d sum;
         for (int i = 0; i < n; ++i) {
             const double t = (i + 0.5) * dt;
             const double r_t = ClampRadius(Sqrt(t * t + 2.0 * r * mu * t + r * r));
             const Densities rho = GetDensities(atm, r_t - atm.bottom_radius);
-            const Vec3d ext = Extinction(atm, rho);
-            const Vec3d tau_mid = tau + ext * (0.5 * dt);
-            tau += ext * dt;
+            const double mid_r = depth_r + rho.rayleigh * (0.5 * dt);
+            const double mid_m = depth_m + rho.mie * (0.5 * dt);
+            const double mid_o = depth_o + rho.absorption * (0.5 * dt);
+            depth_r += rho.rayleigh * dt;
+            depth_m += rho.mie * dt;
+            depth_o += rho.absorption * dt;
             const Rgb ts = TransmittanceToSun(r_t, ClampCosine((r * mu_s + t * nu) / r_t));
-            // ExpLane (physics/vector_exp.h): the wide evaluator's channels
-            // take it in a vector loop; within 1 ulp of std::exp.
-            sum += Vec3d(ts) * ExpLane(-tau_mid) * (rho.mie * dt);
+            const double m = rho.mie * dt;
+            for (int c = 0; c < 3; ++c) {
+                const double tau = atm.rayleigh_scattering[c] * mid_r +
+                                   atm.mie_extinction[c] * mid_m +
+                                   atm.absorption_extinction[c] * mid_o;
+                const float e = ExpLaneF(static_cast<float>(-tau));
+                sum[c] += static_cast<double>(ts[c]) * static_cast<double>(e) * m;
+            }
         }
         return Rgb(sum * atm.mie_scattering);
     }

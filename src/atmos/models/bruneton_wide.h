@@ -158,34 +158,40 @@ struct BrunetonWideEvaluator {
         const float pm = static_cast<float>(MiePhase(atm, nu));
         for (int c = 0; c < n; ++c) out[c] = scattering[c] * pr + single_mie[c] * pm;
     }
-    // SegmentSingleMie (double precision per channel, as the Vec3d original; the
-    // exponentials of all channels in one vector loop).
+    // SegmentSingleMie: the constituents' optical depths once per sample, then
+    // every channel's exponent, exponential (one vector loop) and sum.
     ATMOS_HD void SegmentSingleMie(double r, double mu, double mu_s, double nu, double d,
                                    float* out) const {
         const AtmosphereParameters& atm = lut.atm;
         const int n = w.channels;
         const int steps = lut.cfg.low_sun_mie_steps;
         const double dt = d / steps;
-        double tau[kMaxWideChannels], sum[kMaxWideChannels];
-        for (int c = 0; c < n; ++c) tau[c] = sum[c] = 0.0;
+        double depth_r = 0.0, depth_m = 0.0, depth_o = 0.0;
+        double sum[kMaxWideChannels];
+        for (int c = 0; c < n; ++c) sum[c] = 0.0;
         float ts[kMaxWideChannels];
+        float e[kMaxWideChannels];
         for (int i = 0; i < steps; ++i) {
             const double t = (i + 0.5) * dt;
             const double r_t = lut.ClampRadius(Sqrt(t * t + 2.0 * r * mu * t + r * r));
             const Densities rho = GetDensities(atm, r_t - atm.bottom_radius);
+            const double mid_r = depth_r + rho.rayleigh * (0.5 * dt);
+            const double mid_m = depth_m + rho.mie * (0.5 * dt);
+            const double mid_o = depth_o + rho.absorption * (0.5 * dt);
+            depth_r += rho.rayleigh * dt;
+            depth_m += rho.mie * dt;
+            depth_o += rho.absorption * dt;
             TransmittanceToSun(r_t, ClampCosine((r * mu_s + t * nu) / r_t), ts);
             const double m = rho.mie * dt;
-            double e[kMaxWideChannels];
+            ATMOS_SIMD_WIDE
             for (int c = 0; c < n; ++c) {
-                const double ext = w.rayleigh_scattering[c] * rho.rayleigh +
-                                   w.mie_extinction[c] * rho.mie +
-                                   w.absorption_extinction[c] * rho.absorption;
-                e[c] = -(tau[c] + ext * (0.5 * dt));  // -tau_mid
-                tau[c] += ext * dt;
+                const double tau = w.rayleigh_scattering[c] * mid_r + w.mie_extinction[c] * mid_m +
+                                   w.absorption_extinction[c] * mid_o;
+                e[c] = ExpLaneF(static_cast<float>(-tau));
             }
-            ATMOS_SIMD
-            for (int c = 0; c < n; ++c) e[c] = ExpLane(e[c]);
-            for (int c = 0; c < n; ++c) sum[c] += static_cast<double>(ts[c]) * e[c] * m;
+            for (int c = 0; c < n; ++c) {
+                sum[c] += static_cast<double>(ts[c]) * static_cast<double>(e[c]) * m;
+            }
         }
         for (int c = 0; c < n; ++c) out[c] = static_cast<float>(sum[c] * w.mie_scattering[c]);
     }
