@@ -310,21 +310,15 @@ struct ReferenceHero : ReferenceHybrid {
                              want_ground ? ground : discard);
                 continue;
             }
-            const double u = rng.Uniform() * mass;
-            // nodes[lo].cdf <= u < nodes[hi].cdf
-            const int lo = BisectInterval(count, [&](int i) { return nodes[i].cdf <= u; });
-            const int hi = Min(lo + 1, count - 1);
-            const ViewNode& a = nodes[lo];
-            const ViewNode& b = nodes[hi];
-            const double width = b.t - a.t;
-            const double p_interval = (b.cdf - a.cdf) / mass;
-            if (!(p_interval > 0.0) || !(width > 0.0)) continue;
-            const double t = a.t + rng.Uniform() * width;
+            ViewIntervalPoint v;
+            if (!DrawViewInterval(nodes, count, mass, rng, &v)) continue;
+            const ViewNode& a = nodes[v.lo];
+            const double t = v.t;
             const Vec3d x = start + dir * t;
             const Densities d = GetDensities(atm, Length(x) - atm.bottom_radius);
             const Vec3d rho(d.rayleigh, d.mie, d.absorption);
             const Vec3d column = a.column + (a.rho + rho) * (0.5 * (t - a.t));
-            const double pdf = (1.0 - p_ground) * p_interval / width;
+            const double pdf = (1.0 - p_ground) * v.p_interval / v.width;
             double a_r = 0.0, a_m = 0.0;
             for (int c = 0; c < n; ++c) {
                 w[c] = ExpLane(-Tau(column, c)) * (1.0 / pdf);

@@ -30,6 +30,34 @@ constexpr double kViewMaxStep = 0.5;
 // The most next-event comb points per continuation segment.
 constexpr int kMaxNeeComb = 8;
 
+// A point of the view ray drawn by the mass of a view table (the hybrid's
+// and the hero paths' nodes: .t, .cdf, cdf ascending, `mass` the last cdf):
+// the interval [nodes[lo].t, nodes[lo + 1].t] by its share of the mass
+// (binary search), then a point uniform within it; two uniforms drawn. False
+// for an interval without mass or width (the caller skips the sample).
+struct ViewIntervalPoint {
+    int lo = 0;
+    double t = 0.0;
+    double p_interval = 0.0;  // the interval's probability
+    double width = 0.0;       // its length (m)
+};
+template <typename Node>
+ATMOS_HD inline bool DrawViewInterval(const Node* nodes, int count, double mass, Rng& rng,
+                                      ViewIntervalPoint* out) {
+    const double u = rng.Uniform() * mass;
+    // nodes[lo].cdf <= u < nodes[hi].cdf
+    const int lo = BisectInterval(count, [&](int i) { return nodes[i].cdf <= u; });
+    const int hi = Min(lo + 1, count - 1);
+    const double width = nodes[hi].t - nodes[lo].t;
+    const double p_interval = (nodes[hi].cdf - nodes[lo].cdf) / mass;
+    if (!(p_interval > 0.0) || !(width > 0.0)) return false;
+    out->lo = lo;
+    out->t = nodes[lo].t + rng.Uniform() * width;
+    out->p_interval = p_interval;
+    out->width = width;
+    return true;
+}
+
 struct ReferenceHybrid : ReferenceBaseline {
     // kHybrid: the sun's transmittance table and the factor (>= 1) on the
     // continuation segments' majorants.
@@ -586,22 +614,16 @@ struct ReferenceHybrid : ReferenceBaseline {
                 HybridContinue(normal * (atm.bottom_radius + 1e-3), next, w, 1, sun, rng, ground);
                 continue;
             }
-            // Interval by its mass (binary search on the cdf), then uniform.
-            const double u = rng.Uniform() * mass;
-            // nodes[lo].cdf <= u < nodes[hi].cdf
-            const int lo = BisectInterval(count, [&](int i) { return nodes[i].cdf <= u; });
-            const int hi = Min(lo + 1, count - 1);
-            const ViewNode& a = nodes[lo];
-            const ViewNode& b = nodes[hi];
-            const double width = b.t - a.t;
-            const double p_interval = (b.cdf - a.cdf) / mass;
-            if (!(p_interval > 0.0) || !(width > 0.0)) continue;
-            const double t = a.t + rng.Uniform() * width;
+            // Interval by its mass, then uniform.
+            ViewIntervalPoint v;
+            if (!DrawViewInterval(nodes, count, mass, rng, &v)) continue;
+            const ViewNode& a = nodes[v.lo];
+            const double t = v.t;
             const Vec3d x = start + dir * t;
             const Densities d = GetDensities(atm, Length(x) - atm.bottom_radius);
             const Vec3d sigma_t = Extinction(atm, d);
             const Vec3d trans = Exp(-(a.tau + (a.sigma_t + sigma_t) * (0.5 * (t - a.t))));
-            const double pdf = (1.0 - p_ground) * p_interval / width;
+            const double pdf = (1.0 - p_ground) * v.p_interval / v.width;
             const Vec3d w0 = trans * (1.0 / pdf);
             const Vec3d sigma_r = atm.rayleigh_scattering * d.rayleigh;
             const Vec3d sigma_m = atm.mie_scattering * d.mie;
