@@ -202,6 +202,13 @@ function compile(gl, type, source) {
 var GLSL_HEADER = '#version 300 es\nprecision highp float;\nprecision highp sampler2D;\n' +
                   'precision highp sampler3D;\n';
 
+// Which sampler reads which baked table ("raw" table name).
+var BAKED_SAMPLERS = [['atmos_transmittance_texture', 'transmittance'],
+                      ['atmos_irradiance_texture', 'irradiance'],
+                      ['atmos_scattering_texture', 'scattering'],
+                      ['atmos_single_mie_texture', 'single_mie_scattering'],
+                      ['atmos_multiple_scattering_texture', 'multiple_scattering']];
+
 // One model: its program (GLSL ES header + the bake's constants + common.glsl
 // and the model's functions + MAIN_SHADER) and its textures. The baked
 // tables' textures stay in model.bakedTextures; a GPU precomputation
@@ -211,17 +218,11 @@ function makeModel(gl, name, format, blob) {
   // A model without tables (hosek-wilkie: constants only) has an empty blob.
   if (!data || blob === undefined) throw new Error('no baked data for model ' + name);
   var raw = data.bake.raw.tables;
-  // Texture units: the sampler names of the model's GLSL file.
-  var samplers = {
-    bruneton: [['atmos_transmittance_texture', 'transmittance'],
-               ['atmos_irradiance_texture', 'irradiance'],
-               ['atmos_scattering_texture', 'scattering'],
-               ['atmos_single_mie_texture', 'single_mie_scattering']],
-    hillaire: [['atmos_transmittance_texture', 'transmittance'],
-               ['atmos_multiple_scattering_texture', 'multiple_scattering']],
-    'atmosphere-plus': [['atmos_scattering_texture', 'scattering'],
-                        ['atmos_transmittance_texture', 'transmittance']],
-    'hosek-wilkie': []}[name];
+  // Texture units: every baked table a sampler of the shaders reads, in this
+  // order (the sampler names of shaders/*.glsl, docs/engine.md; the same list
+  // as examples/gl_host's): asked of the bake's tables, not of the model's
+  // name.
+  var samplers = BAKED_SAMPLERS;
   var atm = data.bake.atmosphere;
   var model = {name: name, data: data, textures: [], units: [], tableUnit: {},
                bottom: atm.bottom_radius, top: atm.top_radius};
@@ -344,13 +345,17 @@ function linkHillaireFrame(gl, model, base) {
   var passes = model.hillaire;
   passes.sky = linkProgram(gl, base + SKY_VIEW_MAIN);
   passes.ap = linkProgram(gl, base + AP_MAIN);
+  // The baked tables at the model's units (not the frame's own targets), the
+  // previous slice after every unit.
   [passes.sky, passes.ap].forEach(function (p) {
     gl.useProgram(p);
-    gl.uniform1i(gl.getUniformLocation(p, 'atmos_transmittance_texture'), 0);
-    gl.uniform1i(gl.getUniformLocation(p, 'atmos_multiple_scattering_texture'), 1);
+    model.units.slice(0, model.bakedTextures.length).forEach(function (u) {
+      gl.uniform1i(gl.getUniformLocation(p, u[0]), u[1]);
+    });
   });
-  gl.uniform1i(gl.getUniformLocation(passes.ap, 'u_prev_scatter'), 2);
-  gl.uniform1i(gl.getUniformLocation(passes.ap, 'u_prev_transmittance'), 3);
+  passes.prevUnit = model.units.length;
+  gl.uniform1i(gl.getUniformLocation(passes.ap, 'u_prev_scatter'), passes.prevUnit);
+  gl.uniform1i(gl.getUniformLocation(passes.ap, 'u_prev_transmittance'), passes.prevUnit + 1);
 }
 
 // The frame camera of Hillaire's aerial-perspective volume (atmos_ap_*).
@@ -372,10 +377,11 @@ function buildHillaireFrame(gl, model, view, aspect) {
   var sun = vNormalize(view.sun);
   var mu_s = Math.max(-1, Math.min(1, vDot(sun, pos) / r));
   gl.disable(gl.SCISSOR_TEST);
-  gl.activeTexture(gl.TEXTURE0);
-  gl.bindTexture(gl.TEXTURE_2D, model.textures[0].texture);
-  gl.activeTexture(gl.TEXTURE1);
-  gl.bindTexture(gl.TEXTURE_2D, model.textures[1].texture);
+  model.units.slice(0, model.bakedTextures.length).forEach(function (u) {
+    var t = model.textures[u[1]];
+    gl.activeTexture(gl.TEXTURE0 + u[1]);
+    gl.bindTexture(t.target, t.texture);
+  });
   gl.useProgram(h.sky);
   gl.uniform1f(gl.getUniformLocation(h.sky, 'u_r'), Math.max(r, model.bottom + 1.0));
   gl.uniform3fv(gl.getUniformLocation(h.sky, 'u_sun'),
@@ -400,9 +406,9 @@ function buildHillaireFrame(gl, model, view, aspect) {
                             next[0].texture, 0);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT3, gl.TEXTURE_2D,
                             next[1].texture, 0);
-    gl.activeTexture(gl.TEXTURE2);
+    gl.activeTexture(gl.TEXTURE0 + h.prevUnit);
     gl.bindTexture(gl.TEXTURE_2D, prev[0].texture);
-    gl.activeTexture(gl.TEXTURE3);
+    gl.activeTexture(gl.TEXTURE0 + h.prevUnit + 1);
     gl.bindTexture(gl.TEXTURE_2D, prev[1].texture);
     gl.uniform1i(gl.getUniformLocation(h.ap, 'u_slice'), k);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
