@@ -112,6 +112,7 @@
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
+#include "physics/vector_exp.h"
 #include "physics/wide.h"
 
 #include "base/non_copyable.h"
@@ -324,7 +325,9 @@ struct HillaireEvaluator {
             const Vec3d psi = MultipleScattering(r, mu_s);
             const Vec3d S =
                 t_sun * (sigma_r * phase_r + sigma_m * phase_m) + (sigma_r + sigma_m) * psi;
-            const Vec3d step_t = Exp(-sigma_t * dt);
+            // ExpLane (physics/vector_exp.h): the wide evaluator's channels
+            // take the same exponential as one vector loop.
+            const Vec3d step_t = ExpLane(-sigma_t * dt);
             for (int c = 0; c < 3; ++c) {
                 const double s_int =
                     sigma_t[c] > 0.0 ? (S[c] - S[c] * step_t[c]) / sigma_t[c] : S[c] * dt;

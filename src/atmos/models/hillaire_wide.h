@@ -12,9 +12,10 @@
 //
 // Every function mirrors the HillaireEvaluator or stage function of the same
 // name (models/hillaire.h, models/hillaire_stages.h) channel by channel, in the
-// same operations and order (Vec3d arithmetic is per component; the
-// exponential is the same call): a wide channel equals the three-channel
-// model's bit for bit (tests/wide_channels_test.cpp).
+// same operations and order (Vec3d arithmetic is per component): a wide
+// channel equals the three-channel model's bit for bit
+// (tests/wide_channels_test.cpp). The march steps' exponentials are ExpLane
+// (physics/vector_exp.h) in both: one vector loop over the channels here.
 #pragma once
 
 #include <cstdint>
@@ -137,7 +138,8 @@ struct HillaireWideEvaluator {
                        (sigma_r + sigma_m) * static_cast<double>(psi[c]);
                 step_t[c] = -sigma_t[c] * dt;
             }
-            for (int c = 0; c < n; ++c) step_t[c] = Exp(step_t[c]);
+            ATMOS_SIMD
+            for (int c = 0; c < n; ++c) step_t[c] = ExpLane(step_t[c]);
             for (int c = 0; c < n; ++c) {
                 const double s_int =
                     sigma_t[c] > 0.0 ? (S[c] - S[c] * step_t[c]) / sigma_t[c] : S[c] * dt;
@@ -440,7 +442,8 @@ struct HillaireWideMultipleScatteringStage {
                                      w.absorption_extinction[c] * d.absorption;
                         step_t[c] = -sigma_t[c] * dt;
                     }
-                    for (int c = 0; c < n; ++c) step_t[c] = Exp(step_t[c]);
+                    ATMOS_SIMD
+                    for (int c = 0; c < n; ++c) step_t[c] = ExpLane(step_t[c]);
                     for (int c = 0; c < n; ++c) {
                         const double S = sigma_s[c] * static_cast<double>(t_sun[c]) * p_u;
                         const double wt = sigma_t[c] > 0.0 ? (1.0 - step_t[c]) / sigma_t[c] : dt;
