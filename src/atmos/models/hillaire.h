@@ -99,6 +99,10 @@
 // frame sky-view and aerial perspective) are built by the stage structs of
 // hillaire_stages.h through RunStage: on the CPU, or, on the CUDA backend
 // (`--backend cuda`), on the device from the same code.
+//
+// Wide channel batches (a spectral run's up to 16 batches of three in one
+// model: PrepareWide, RenderWide, SampleWide): hillaire_wide.h, every table
+// and lookup with n channels, bit for bit the batches' values.
 #pragma once
 
 #include <memory>
