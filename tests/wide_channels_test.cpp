@@ -8,8 +8,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "atmos/atmosphere.h"
@@ -20,6 +22,7 @@
 #include "base/parallel.h"
 #include "base/rng.h"
 #include "harness/spectral_run.h"
+#include "models/hillaire.h"
 #include "physics/wide.h"
 #include "test_util.h"
 
@@ -31,6 +34,15 @@ const char* kSmallBruneton =
     "bruneton:orders=2:scattering-samples=20:transmittance-width=32:transmittance-height=8:"
     "irradiance-width=16:irradiance-height=4:scattering-r=8:scattering-mu=16:"
     "scattering-mu-s=8:scattering-nu=4";
+
+// hillaire's tables have fixed sizes: few march steps instead (the
+// multiple-scattering table's 64 x 20 steps per texel are fixed too). The
+// second form takes the other ground and sample paths and the demo's offset.
+const char* kSmallHillaire =
+    "hillaire:steps=6:sky-view-steps=5:transmittance-steps=6:ap-steps-per-slice=1";
+const char* kSmallHillaireOtherPaths =
+    "hillaire:steps=5:sky-view-steps=4:transmittance-steps=5:ap-steps-per-slice=1:"
+    "ground-path=sky-view:sample-path=march:segment-offset=0.3";
 
 SpectralBatching Batching(bool wide) {
     SpectralBatching b;
@@ -113,7 +125,8 @@ TEST_P(WideChannels, RenderAndSampleEqualTheThreeChannelBatchesBitForBit) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, WideChannels,
-                         ::testing::Values(kSmallBruneton, "naive", "naive:steps=7:light-steps=5"),
+                         ::testing::Values(kSmallBruneton, "naive", "naive:steps=7:light-steps=5",
+                                           kSmallHillaire, kSmallHillaireOtherPaths),
                          [](const ::testing::TestParamInfo<const char*>& param) {
                              return ParseModelSpec(param.param).name + std::to_string(param.index);
                          });
@@ -176,6 +189,45 @@ TEST(WideChannelBatches, NaiveRunsTheBatchesWhereTheirShellsDiffer) {
     request.sun_disc = true;
     ExpectSameFloats(RenderSpectral(spec, spectral, nm, request, prepare, Batching(true)).values,
                      RenderSpectral(spec, spectral, nm, request, prepare, Batching(false)).values);
+}
+
+TEST(WideChannelBatches, HillaireWideTablesAreTheBatchesTablesSideBySide) {
+    // The transmittance and multiple-scattering tables of PrepareWide hold
+    // each batch's Prepare() tables at channels 3b .. 3b + 2, bit for bit.
+    const SpectralAtmosphere spectral = LoadSpectralAtmosphere("kider-2013");
+    std::vector<AtmosphereParameters> batches = {spectral.AtWavelengths(380, 420, 470),
+                                                 spectral.AtWavelengths(530, 590, 660),
+                                                 spectral.AtWavelengths(700, 740, 780)};
+    batches[1].ground_albedo = Vec3d(0.0);  // a batch without a lit ground
+    const std::map<std::string, std::string> options = {{"transmittance-steps", "7"}};
+    const HillaireOptions o = HillaireModel::OptionRows().Parse("hillaire", options);
+    HillaireModel wide(o);
+    wide.PrepareWide(batches);
+    const int n = 9;
+    ASSERT_EQ(wide.wide_transmittance_table().channels(), n);
+    ASSERT_EQ(wide.wide_multiple_scattering_table().channels(), n);
+    for (int b = 0; b < 3; ++b) {
+        SCOPED_TRACE(b);
+        HillaireModel three(o);
+        three.Prepare(batches[b]);
+        for (const auto& [narrow, wide_table] :
+             {std::make_pair(&three.transmittance_table(), &wide.wide_transmittance_table()),
+              std::make_pair(&three.multiple_scattering_table(),
+                             &wide.wide_multiple_scattering_table())}) {
+            ASSERT_EQ(narrow->width(), wide_table->width());
+            ASSERT_EQ(narrow->height(), wide_table->height());
+            const size_t texels = static_cast<size_t>(narrow->width()) * narrow->height();
+            size_t differ = 0;
+            for (size_t t = 0; t < texels; ++t) {
+                for (int c = 0; c < 3; ++c) {
+                    const float a = narrow->data()[t * 3 + c];
+                    const float x = wide_table->data()[t * n + 3 * b + c];
+                    if (std::memcmp(&a, &x, sizeof(float)) != 0) ++differ;
+                }
+            }
+            EXPECT_EQ(differ, 0u);
+        }
+    }
 }
 
 TEST(WideChannelBatches, RefusesBatchesThatDifferBeyondTheirCoefficients) {

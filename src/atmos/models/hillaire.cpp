@@ -17,9 +17,11 @@
 #include "io/raw_tables.h"
 #include "io/table_io.h"
 #include "models/hillaire_stages.h"
+#include "models/hillaire_wide.h"
 #include "models/option_json.h"
 #include "models/order_check.h"
 #include "render/stages.h"
+#include "render/wide.h"
 
 namespace atmos {
 
@@ -45,6 +47,7 @@ ModelInfo HillaireModel::StaticInfo() {
     info.capabilities.multiple_scattering = true;
     info.capabilities.precomputed = true;
     info.options = OptionRows().Specs();
+    info.capabilities.wide_channels = true;
     info.capabilities.shader = "hillaire";
     info.capabilities.validity_notes = {
         "optically thick atmospheres are past the method's limit: Prepare warns on stderr when "
@@ -254,6 +257,127 @@ std::vector<SampleAnswer> HillaireModel::Sample(const std::vector<SampleQuery>& 
     HillaireEvaluator e = evaluator_;
     e.per_query_sky_view_steps = sky_view_steps_;
     return SampleAll(e, atm.bottom_radius, queries);
+}
+
+// --- Wide channel batches (models/hillaire_wide.h) ---------------------------
+
+void HillaireModel::PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                                const BatchPrepare&) {
+    for (const AtmosphereParameters& a : batches) {
+        WarnOutsideValidityDomain(Info(), a);
+        ValidateAtmosphere(a);
+    }
+    const WideCoefficients w = MakeWideCoefficients(batches);
+    const int n = w.channels;
+    // The stages read the model's evaluator without tables, as Prepare()'s.
+    HillaireWideEvaluator e;
+    e.narrow = StageEvaluator();
+    e.narrow.atm = batches[0];
+    e.w = w;
+    Table transmittance(kHillaireTransmittanceWidth, kHillaireTransmittanceHeight, 1, n);
+    HillaireWideTransmittanceStage t;
+    t.atm = batches[0];
+    t.w = w;
+    t.steps = transmittance_steps_;
+    t.out = transmittance.data();
+    ParallelFor(int64_t{kHillaireTransmittanceWidth} * kHillaireTransmittanceHeight, 64,
+                [&t](int64_t i) { t(i); });
+    e.narrow.transmittance = transmittance.view();
+    Table multiple_scattering(kHillaireMsSize, kHillaireMsSize, 1, n);
+    Table transfer(kHillaireMsSize, kHillaireMsSize, 1, n);
+    HillaireWideMultipleScatteringStage ms;
+    ms.e = e;
+    ms.e.narrow.use_multiple_scattering = false;
+    ms.e.narrow.multiple_scattering = TableView{};  // not read (the table being built)
+    ms.out = multiple_scattering.data();
+    ms.transfer = transfer.data();
+    ParallelFor(int64_t{kHillaireMsSize} * kHillaireMsSize, 4, [&ms](int64_t i) { ms(i); });
+    wide_atm_ = batches[0];
+    wide_ = w;
+    wide_transmittance_ = std::move(transmittance);
+    wide_multiple_scattering_ = std::move(multiple_scattering);
+    WarnIfSeriesPastLimit("hillaire", TableMax(transfer));
+}
+
+namespace {
+
+// The wide evaluator of a model's wide tables (no frame tables).
+HillaireWideEvaluator WideEvaluator(const HillaireEvaluator& base, const AtmosphereParameters& atm,
+                                    const WideCoefficients& w, const Table& transmittance,
+                                    const Table& multiple_scattering) {
+    HillaireWideEvaluator e;
+    e.narrow = base;
+    e.narrow.atm = atm;
+    e.narrow.transmittance = transmittance.view();
+    e.narrow.multiple_scattering = multiple_scattering.view();
+    e.narrow.sky_view = e.narrow.ap_scatter = e.narrow.ap_transmittance = TableView{};
+    e.narrow.per_query_sky_view_steps = 0;
+    e.w = w;
+    return e;
+}
+
+}  // namespace
+
+void HillaireModel::RenderWide(const RenderRequest& request, std::vector<float>* values) const {
+    if (!wide_transmittance_.size()) {
+        Fail("model hillaire: PrepareWide() must run before RenderWide()");
+    }
+    const int n = wide_.channels;
+    const WidePixelSetup setup = MakeWidePixelSetup(request, wide_atm_, wide_);
+    // The frame's tables as BuildFrame builds them, n channels.
+    const HillaireWideEvaluator stage_e =
+        WideEvaluator(evaluator_, wide_atm_, wide_, wide_transmittance_, wide_multiple_scattering_);
+    HillaireWideEvaluator e = stage_e;
+    Table sky_view, ap_scatter, ap_transmittance;
+    const Camera& camera_frame = request.view.camera;
+    const Vec3d camera = camera_frame.position;
+    const Vec3d sun = request.view.sun_direction;
+    const double r = Length(camera);
+    if (r <= wide_atm_.top_radius) {
+        const double mu_s = ClampCosine(Dot(sun, camera) / r);
+        sky_view.Resize(kHillaireSkyViewWidth, kHillaireSkyViewHeight, 1, n);
+        HillaireWideSkyViewStage sv;
+        sv.e = stage_e;
+        sv.r = Max(r, wide_atm_.bottom_radius + kHillaireSkyViewMinAltitude);
+        sv.sun = Vec3d(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
+        sv.steps = sky_view_steps_;
+        sv.out = sky_view.data();
+        ParallelFor(int64_t{kHillaireSkyViewWidth} * kHillaireSkyViewHeight, 32,
+                    [&sv](int64_t i) { sv(i); });
+        e.narrow.sky_view = sky_view.view();
+        // The volume is a perspective frustum (Render).
+        if (evaluator_.ground_from_ap && camera_frame.projection == Projection::kPerspective) {
+            const double aspect = static_cast<double>(request.width) / request.height;
+            ap_scatter.Resize(kHillaireApSize, kHillaireApSize, kHillaireApSize, n);
+            ap_transmittance.Resize(kHillaireApSize, kHillaireApSize, kHillaireApSize, n);
+            HillaireWideAerialPerspectiveStage ap;
+            ap.e = stage_e;
+            ap.camera = camera_frame;
+            ap.sun = sun;
+            ap.aspect = aspect;
+            ap.metres_per_slice = evaluator_.ap_metres_per_slice;
+            ap.steps_per_slice = ap_steps_per_slice_;
+            ap.scatter = ap_scatter.data();
+            ap.transmittance = ap_transmittance.data();
+            ParallelFor(int64_t{kHillaireApSize} * kHillaireApSize, 4, [&ap](int64_t i) { ap(i); });
+            e.narrow.ap_camera = camera_frame;
+            e.narrow.ap_aspect = aspect;
+            e.narrow.ap_scatter = ap_scatter.view();
+            e.narrow.ap_transmittance = ap_transmittance.view();
+        }
+    }
+    RenderWideImage(e, setup, values);
+}
+
+std::vector<float> HillaireModel::SampleWide(const std::vector<SampleQuery>& queries) const {
+    if (!wide_transmittance_.size()) {
+        Fail("model hillaire: PrepareWide() must run before SampleWide()");
+    }
+    HillaireWideEvaluator e =
+        WideEvaluator(evaluator_, wide_atm_, wide_, wide_transmittance_, wide_multiple_scattering_);
+    // As Sample: the table path computes each query's four sky-view texels.
+    if (sample_with_tables_) e.narrow.per_query_sky_view_steps = sky_view_steps_;
+    return SampleAllWide(e, wide_atm_.bottom_radius, queries);
 }
 
 // --- Bake -----------------------------------------------------------------

@@ -99,6 +99,10 @@
 // frame sky-view and aerial perspective) are built by the stage structs of
 // hillaire_stages.h through RunStage: on the CPU, or, on the CUDA backend
 // (`--backend cuda`), on the device from the same code.
+//
+// Wide channel batches (a spectral run's up to 16 batches of three in one
+// model: PrepareWide, RenderWide, SampleWide): hillaire_wide.h, every table
+// and lookup with n channels, bit for bit the batches' values.
 #pragma once
 
 #include <memory>
@@ -112,6 +116,8 @@
 #include "physics/density.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
+#include "physics/vector_exp.h"
+#include "physics/wide.h"
 
 #include "base/non_copyable.h"
 
@@ -323,7 +329,9 @@ struct HillaireEvaluator {
             const Vec3d psi = MultipleScattering(r, mu_s);
             const Vec3d S =
                 t_sun * (sigma_r * phase_r + sigma_m * phase_m) + (sigma_r + sigma_m) * psi;
-            const Vec3d step_t = Exp(-sigma_t * dt);
+            // ExpLane (physics/vector_exp.h): the wide evaluator's channels
+            // take the same exponential as one vector loop.
+            const Vec3d step_t = ExpLane(-sigma_t * dt);
             for (int c = 0; c < 3; ++c) {
                 const double s_int =
                     sigma_t[c] > 0.0 ? (S[c] - S[c] * step_t[c]) / sigma_t[c] : S[c] * dt;
@@ -527,6 +535,20 @@ class HillaireModel : public Model {
     int64_t TableBytes() const override;
     void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere) override;
 
+    // Wide channel batches (models/hillaire_wide.h): PrepareWide builds the
+    // transmittance and multiple-scattering tables of every batch at once (n
+    // channels per texel; `prepare_batch` is not called: the tables are the
+    // batches' own, computed together); RenderWide builds the frame's
+    // sky-view and aerial-perspective tables with n channels and renders
+    // through them; SampleWide answers as Sample.
+    void PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                     const BatchPrepare& prepare_batch = {}) override;
+    void RenderWide(const RenderRequest& request, std::vector<float>* values) const override;
+    std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
+    // The wide tables of the last PrepareWide (n channels per texel), for tests.
+    const Table& wide_transmittance_table() const { return wide_transmittance_; }
+    const Table& wide_multiple_scattering_table() const { return wide_multiple_scattering_; }
+
     // Per-frame work, exposed for benchmarks: the sky-view table for a camera
     // at `camera` and sun `sun` (when inside the atmosphere), and with
     // `with_aerial_perspective` the volume for `camera_frame` at aspect ratio
@@ -563,6 +585,11 @@ class HillaireModel : public Model {
     int ap_steps_per_slice_ = 4;
     bool sample_with_tables_ = true;
     Table transmittance_, multiple_scattering_;
+    // Wide channel batches: batch 0's atmosphere (the common fields), the
+    // channels' coefficients and the n-channel tables (empty: not prepared).
+    AtmosphereParameters wide_atm_;
+    WideCoefficients wide_;
+    Table wide_transmittance_, wide_multiple_scattering_;
     mutable ResidentTables resident_;  // the tables' device copies (render/stages.h)
 };
 

@@ -107,7 +107,7 @@ struct HillaireMultipleScatteringStage {
                     const Vec3d sigma_t = Extinction(atm, d);
                     const Vec3d t_sun = e.SunTransmittance(rp, ClampCosine(Dot(p, sun) / rp));
                     const Vec3d S = sigma_s * t_sun * p_u;
-                    const Vec3d step_t = Exp(-sigma_t * dt);
+                    const Vec3d step_t = ExpLane(-sigma_t * dt);  // as Integrate
                     for (int c = 0; c < 3; ++c) {
                         const double w = sigma_t[c] > 0.0 ? (1.0 - step_t[c]) / sigma_t[c] : dt;
                         L[c] += T[c] * S[c] * w;
