@@ -153,6 +153,57 @@ void WideDirectIrradiance(const BrunetonWideEvaluator& ev, Table* out) {
             });
 }
 
+// The per-texel geometry of one view-ray sample of a row, in functions of
+// plain arguments (inside the row lambdas GCC leaves these loops scalar; here
+// they vectorise, lane by lane the same IEEE operations).
+//
+// Single scattering: each texel's sun-disc factor f and transmittance texel
+// span along mu (ComputeBrunetonSingleScatteringRows' inner loop).
+__attribute__((noinline)) void SunColumns(int width, double r, const double* mu_s_x,
+                                          const double* nu_x, double s_d, double s_r,
+                                          double cos_theta_h, double e0, double e_range, double rr,
+                                          double top2, double u_off, double d_min, double d_range,
+                                          double u_scale, int t_width, float* f_x, int* i0_x,
+                                          int* i1_x, float* fx_x) {
+    ATMOS_SIMD_WIDE
+    for (int k = 0; k < width; ++k) {
+        const double mu_s_d = ClampCosine((r * mu_s_x[k] + s_d * nu_x[k]) / s_r);
+        const double t = Clamp(((mu_s_d - cos_theta_h) - e0) / e_range, 0.0, 1.0);
+        f_x[k] = static_cast<float>(t * t * (3.0 - 2.0 * t));
+        const double d = Max(-s_r * mu_s_d + SafeSqrt(rr * (mu_s_d * mu_s_d - 1.0) + top2), 0.0);
+        const double u = u_off + ((d - d_min) / d_range) * u_scale;
+        const TexelSpan tx = SplitSpan(u, t_width);
+        i0_x[k] = tx.i0;
+        i1_x[k] = tx.i1;
+        fx_x[k] = tx.f;
+    }
+}
+// Multiple scattering: each texel's mu_s coordinate at the sample and its two
+// nu slices' spans (ComputeBrunetonMultipleScatteringRows' inner loop).
+__attribute__((noinline)) void DensityColumns(int width, double r, const double* mu_s_x,
+                                              const double* nu_x, const double* tex_x, double s_d,
+                                              double inv_r, double bottom, double bb, double top2,
+                                              double mu_s_d_min, double inv_d_range,
+                                              double inv_big_a, TexelCentreMap mu_s_map,
+                                              double inv_nu, int* a0_x, int* a1_x, int* b0_x,
+                                              int* b1_x, float* fa_x, float* fb_x) {
+    ATMOS_SIMD_WIDE
+    for (int k = 0; k < width; ++k) {
+        const double ms = ClampCosine((r * mu_s_x[k] + s_d * nu_x[k]) * inv_r);
+        const double d = Max(-bottom * ms + SafeSqrt(bb * (ms * ms - 1.0) + top2), 0.0);
+        const double a = (d - mu_s_d_min) * inv_d_range;
+        const double u_mu_s = mu_s_map(Max(1.0 - a * inv_big_a, 0.0) / (1.0 + a));
+        const TexelSpan sa = SplitSpan((tex_x[k] + u_mu_s) * inv_nu, width);
+        const TexelSpan sb = SplitSpan((tex_x[k] + 1.0 + u_mu_s) * inv_nu, width);
+        a0_x[k] = sa.i0;
+        a1_x[k] = sa.i1;
+        b0_x[k] = sb.i0;
+        b1_x[k] = sb.i1;
+        fa_x[k] = sa.f;
+        fb_x[k] = sb.f;
+    }
+}
+
 // ---- single scattering (ComputeBrunetonSingleScatteringRows per channel) ----
 void WideSingleScattering(const BrunetonWideEvaluator& ev,
                           const std::vector<AtmosphereParameters>& batches, Table* rayleigh,
@@ -258,19 +309,8 @@ void WideSingleScattering(const BrunetonWideEvaluator& ev,
                 const float fy = ty.f;
                 const double s_d = sd[si];
                 // The texels' geometry (vectorised over the row)...
-                ATMOS_SIMD_WIDE
-                for (int k = 0; k < width; ++k) {
-                    const double mu_s_d = ClampCosine((r * mu_s_x[k] + s_d * nu_x[k]) / s_r);
-                    const double t = Clamp(((mu_s_d - cos_theta_h) - e0) / e_range, 0.0, 1.0);
-                    f_x[k] = static_cast<float>(t * t * (3.0 - 2.0 * t));
-                    const double d =
-                        Max(-s_r * mu_s_d + SafeSqrt(rr * (mu_s_d * mu_s_d - 1.0) + top2), 0.0);
-                    const double u = u_off + ((d - d_min) / d_range) * u_scale;
-                    const TexelSpan tx = SplitSpan(u, t_width);
-                    i0_x[k] = tx.i0;
-                    i1_x[k] = tx.i1;
-                    fx_x[k] = tx.f;
-                }
+                SunColumns(width, r, mu_s_x, nu_x, s_d, s_r, cos_theta_h, e0, e_range, rr, top2,
+                           u_off, d_min, d_range, u_scale, t_width, f_x, i0_x, i1_x, fx_x);
                 // ...then the channels (vectorised over them). A texel whose
                 // sun is below the horizon (f = 0) adds 0 to its sums: skipped.
                 const float* const tr = st.data() + si * nn;
@@ -724,23 +764,9 @@ void WideMultipleScattering(const BrunetonWideEvaluator& ev,
                            (q2[j] * (1.0f - fy) + q3[j] * fy) * fz;
                 }
                 const double s_d = sd[si], inv_r = sinv[si];
-                ATMOS_SIMD_WIDE
-                for (int k = 0; k < width; ++k) {
-                    const double ms = ClampCosine((r * mu_s_x[k] + s_d * nu_x[k]) * inv_r);
-                    const double d =
-                        Max(-kc.bottom * ms + SafeSqrt(bb * (ms * ms - 1.0) + top2), 0.0);
-                    const double a = (d - kc.mu_s_d_min) * inv_d_range;
-                    const double u_mu_s =
-                        kc.scattering_mu_s(Max(1.0 - a * inv_big_a, 0.0) / (1.0 + a));
-                    const TexelSpan sa = SplitSpan((tex_x[k] + u_mu_s) * inv_nu, width);
-                    const TexelSpan sb = SplitSpan((tex_x[k] + 1.0 + u_mu_s) * inv_nu, width);
-                    a0_x[k] = sa.i0;
-                    a1_x[k] = sa.i1;
-                    b0_x[k] = sb.i0;
-                    b1_x[k] = sb.i1;
-                    fa_x[k] = sa.f;
-                    fb_x[k] = sb.f;
-                }
+                DensityColumns(width, r, mu_s_x, nu_x, tex_x, s_d, inv_r, kc.bottom, bb, top2,
+                               kc.mu_s_d_min, inv_d_range, inv_big_a, kc.scattering_mu_s, inv_nu,
+                               a0_x, a1_x, b0_x, b1_x, fa_x, fb_x);
                 const float* const t = st.data() + si * nn;
                 for (size_t k = 0; k < wz; ++k) {
                     const float* pa0 = p + static_cast<size_t>(a0_x[k]) * nn;
