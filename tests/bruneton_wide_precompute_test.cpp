@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -115,6 +117,8 @@ struct Case {
     int orders;
 };
 
+void PrintTo(const Case& c, std::ostream* os) { *os << c.preset << ", orders " << c.orders; }
+
 class BrunetonWidePrecompute : public ::testing::TestWithParam<Case> {};
 
 TEST_P(BrunetonWidePrecompute, EqualsTheBatchesTablesBitForBit) {
@@ -184,8 +188,8 @@ TEST(BrunetonWidePrecompute, RefusesCombinedMieStorage) {
 
 // The stage times of the default tables: RGB (earth's preset) and 40
 // wavelengths at once (earth-spectral, 14 batches), one thread, interleaved
-// rounds. ATMOS_WIDE_PRECOMPUTE_ORDERS sets the orders (default 4),
-// ATMOS_WIDE_PRECOMPUTE_ROUNDS the rounds (default 3).
+// rounds; wall and process CPU time of each precomputation. ATMOS_WIDE_PRECOMPUTE_ORDERS sets the
+// orders (default 4), ATMOS_WIDE_PRECOMPUTE_ROUNDS the rounds (default 3).
 TEST(BrunetonWidePrecompute, DISABLED_StageTimes) {
     BrunetonConfig c;
     if (const char* o = std::getenv("ATMOS_WIDE_PRECOMPUTE_ORDERS")) c.orders = std::atoi(o);
@@ -205,6 +209,7 @@ TEST(BrunetonWidePrecompute, DISABLED_StageTimes) {
             const StageLogScope scope(&log);
             BrunetonTables t;
             const auto start = std::chrono::steady_clock::now();
+            const std::clock_t cpu_start = std::clock();
             if (wide) {
                 PrecomputeBrunetonWide(batches, c, &t);
             } else {
@@ -212,7 +217,9 @@ TEST(BrunetonWidePrecompute, DISABLED_StageTimes) {
             }
             const double s =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            std::printf("round %d %s: %.3f s\n", round, wide ? "wide 40" : "RGB", s);
+            const double cpu = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+            std::printf("round %d %s: %.3f s wall, %.3f s CPU\n", round, wide ? "wide 40" : "RGB",
+                        s, cpu);
             for (const StageTime& st : log) {
                 std::printf("  %-45s %10.1f ms\n", st.name.c_str(), st.kernel_ms);
             }
