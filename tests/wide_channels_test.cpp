@@ -131,10 +131,12 @@ INSTANTIATE_TEST_SUITE_P(Models, WideChannels,
                              return ParseModelSpec(param.param).name + std::to_string(param.index);
                          });
 
-TEST(WideChannelBatches, BrunetonPreparesEachBatchThroughTheRunsPrepareFunction) {
-    // The CLI's prepare function goes through the table cache (or --load):
-    // the wide model gathers the batches' tables through it, one call per
-    // batch, as the three-channel path makes them.
+TEST(WideChannelBatches, BrunetonPrecomputesAllChannelsOrGathersThroughThePrepareFunction) {
+    // By default the wide model precomputes every channel at once: the run's
+    // prepare function is not called. With SpectralBatching::prepare_wide
+    // passing it on (the CLI does when its table cache holds every batch's
+    // tables) the model gathers the batches' tables through it, one call per
+    // batch; the values are the same either way.
     const SpectralAtmosphere spectral = LoadSpectralAtmosphere("kider-2013");
     const std::vector<double> nm = {380, 420, 470, 530, 590, 660, 760};
     int calls = 0;
@@ -143,13 +145,25 @@ TEST(WideChannelBatches, BrunetonPreparesEachBatchThroughTheRunsPrepareFunction)
         m->Prepare(a);
     };
     const std::vector<SampleQuery> queries = Queries();
-    const std::vector<double> wide = SampleSpectral(ParseModelSpec(kSmallBruneton), spectral, nm,
-                                                    queries, {}, prepare, Batching(true));
+    const std::vector<double> at_once = SampleSpectral(ParseModelSpec(kSmallBruneton), spectral, nm,
+                                                       queries, {}, prepare, Batching(true));
+    EXPECT_EQ(calls, 0);
+    SpectralBatching gather = Batching(true);
+    int wide_calls = 0;
+    gather.prepare_wide = [&](const std::vector<AtmosphereParameters>& group, Model* model,
+                              const PrepareFunction& p) {
+        ++wide_calls;
+        model->PrepareWide(group, p);
+    };
+    const std::vector<double> gathered =
+        SampleSpectral(ParseModelSpec(kSmallBruneton), spectral, nm, queries, {}, prepare, gather);
+    EXPECT_EQ(wide_calls, 1);
     EXPECT_EQ(calls, 3);
+    EXPECT_EQ(at_once, gathered);
     // A prepare function that leaves the model unprepared is refused.
     EXPECT_THROW(SampleSpectral(
                      ParseModelSpec(kSmallBruneton), spectral, nm, queries, {},
-                     [](const AtmosphereParameters&, Model*) {}, Batching(true)),
+                     [](const AtmosphereParameters&, Model*) {}, gather),
                  Error);
 }
 

@@ -102,6 +102,23 @@ double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphe
     return Seconds(start);
 }
 
+WidePrepareFunction CliWidePrepare(const CommonOptions& o) {
+    return [&o](const std::vector<AtmosphereParameters>& group, Model* model,
+                const PrepareFunction& prepare) {
+        const TableCacheSettings cache = UserTableCache(o.no_cache);
+        bool cached = o.load.empty() && !group.empty();
+        for (const AtmosphereParameters& a : group) {
+            cached = cached && TableCacheHasEntry(*model, GivenModel(o).options, a, cache);
+        }
+        if (cached || !o.load.empty()) {
+            model->PrepareWide(group, prepare);
+            return;
+        }
+        const LibraryProgressScope progress(!o.quiet);
+        model->PrepareWide(group);
+    };
+}
+
 void CheckSpectralFlagsNeedWavelengths(const SpectralFlags& flags) {
     if (!flags.wavelengths.empty()) return;
     const SpectralFlags defaults;

@@ -50,6 +50,12 @@ double Seconds(std::chrono::steady_clock::time_point since);
 // Prepare()s the model for the atmosphere, or loads its baked tables with
 // --load; returns the seconds it took.
 double PrepareModel(const CommonOptions& o, const AtmosphereParameters& atmosphere, Model* model);
+// How a spectral run's wide group is prepared (SpectralBatching::prepare_wide):
+// the batches' tables through PrepareModel (the table cache) when the cache
+// holds every batch's, else the model's own precomputation of all the
+// channels (bruneton: one instead of one per batch; not stored in the cache),
+// with the progress bar as PrepareModel shows it.
+WidePrepareFunction CliWidePrepare(const CommonOptions& o);
 
 // The flags the studies (compare, bench, validate; studies/) share, declared once:
 // --atmosphere, --set, --threads, and --quiet / --backend where the study has them.

@@ -114,7 +114,7 @@ int CmdRender(const CommonOptions& common, const RenderOptions& ro) {
         RenderSpectralViews(
             run, GivenModel(common),
             {f.wavelengths, f.colour, f.white, f.batch_seeds, f.batch_layout, common.atmosphere,
-             common.sets, !common.load.empty(), f.channel_batches},
+             common.sets, !common.load.empty(), f.channel_batches, CliWidePrepare(common)},
             views, [&](const AtmosphereParameters& a, Model* m) { PrepareModel(common, a, m); });
         return 0;
     }

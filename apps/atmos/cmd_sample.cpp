@@ -45,6 +45,7 @@ int CmdSample(const CommonOptions& common, const MonteCarloFlags& flags, const S
         SpectralBatching batching = ParseSpectralBatching(spectral);
         // Baked tables are loaded per batch (PrepareModel): no wide path.
         if (!common.load.empty()) batching.wide = false;
+        batching.prepare_wide = CliWidePrepare(common);
         std::vector<SampleQuery> queries = ReadQueries(io.input);
         for (SampleQuery& q : queries) q.ground = io.ground ? 1 : 0;
         return SampleSpectralCsv(common, mc, spectral.wavelengths, queries, batching, io.output,

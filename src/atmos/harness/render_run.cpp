@@ -186,6 +186,7 @@ void RenderSpectralViews(const RenderRun& run, const ModelSpec& spec,
     batching.seeds = ParseBatchSeeds(flags.batch_seeds);
     batching.layout = ParseBatchLayout(flags.batch_layout);
     batching.wide = ParseChannelBatches(flags.channel_batches);
+    batching.prepare_wide = flags.prepare_wide;
     const SpectralAtmosphere atmosphere = LoadSpectralAtmosphere(flags.atmosphere, flags.sets);
     const bool all_views = run.all_views;
     const int width = run.width, height = run.height;

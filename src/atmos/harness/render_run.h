@@ -69,6 +69,7 @@ struct SpectralRenderFlags {
     std::vector<std::string> sets;
     bool load = false;                     // --load given (refused)
     std::string channel_batches = "wide";  // --channel-batches
+    WidePrepareFunction prepare_wide;      // SpectralBatching::prepare_wide
 };
 
 // --wavelengths: the views rendered at each wavelength (harness/spectral_run.h);

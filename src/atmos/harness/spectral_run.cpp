@@ -51,13 +51,13 @@ void ForEachPreparedBatch(const ModelSpec& spec, const SpectralAtmosphere& atmos
 // The wide path (SpectralBatching::wide): calls each(indices, stored, model,
 // batches) for groups of at most kMaxWideChannels / 3 consecutive batches of
 // SpectralBatches, with one model of `spec` prepared for all of them
-// (PrepareWide, with `prepare` for each batch's tables): `indices[g]` and `stored[g]` are the g-th
-// batch's, `batches[g]` its atmosphere; the model's channel 3g + c is that batch's channel c.
+// (PrepareWide, or batching.prepare_wide with `prepare`): `indices[g]` and `stored[g]` are the
+// g-th batch's, `batches[g]` its atmosphere; the model's channel 3g + c is that batch's channel c.
 template <typename F>
 void ForEachWideGroup(const ModelSpec& spec, const SpectralAtmosphere& atmosphere,
-                      const std::vector<double>& nm, BatchLayout layout,
+                      const std::vector<double>& nm, const SpectralBatching& batching,
                       const PrepareFunction& prepare, F each) {
-    const std::vector<std::array<size_t, 3>> batches = SpectralBatches(nm.size(), layout);
+    const std::vector<std::array<size_t, 3>> batches = SpectralBatches(nm.size(), batching.layout);
     const size_t per_group = static_cast<size_t>(kMaxWideChannels / 3);
     for (size_t first = 0; first < batches.size(); first += per_group) {
         const size_t count = std::min(per_group, batches.size() - first);
@@ -71,7 +71,11 @@ void ForEachWideGroup(const ModelSpec& spec, const SpectralAtmosphere& atmospher
         }
         std::unique_ptr<Model> model = CreateModel(spec);
         RequireSpectralModel(model->Info());
-        model->PrepareWide(group, prepare);
+        if (batching.prepare_wide) {
+            batching.prepare_wide(group, model.get(), prepare);
+        } else {
+            model->PrepareWide(group);
+        }
         each(indices, stored, *model, group);
     }
 }
@@ -189,7 +193,7 @@ std::vector<SpectralImage> RenderSpectralRequests(
     if (reports) reports->assign(requests.size(), MonteCarloReport());
     if (UsesWideBatches(CreateModel(spec)->Info(), batching)) {
         ForEachWideGroup(
-            spec, atmosphere, nm, batching.layout, prepare,
+            spec, atmosphere, nm, batching, prepare,
             [&](const std::vector<std::array<size_t, 3>>& indices,
                 const std::vector<size_t>& stored, Model& model,
                 const std::vector<AtmosphereParameters>&) {
@@ -307,7 +311,7 @@ std::vector<double> SampleSpectral(const ModelSpec& spec, const SpectralAtmosphe
     const size_t n = nm.size();
     std::vector<double> out(queries.size() * n, 0.0);
     if (UsesWideBatches(CreateModel(spec)->Info(), batching)) {
-        ForEachWideGroup(spec, atmosphere, nm, batching.layout, prepare,
+        ForEachWideGroup(spec, atmosphere, nm, batching, prepare,
                          [&](const std::vector<std::array<size_t, 3>>& indices,
                              const std::vector<size_t>& stored, Model& model,
                              const std::vector<AtmosphereParameters>& batches) {

@@ -62,29 +62,39 @@ BatchLayout ParseBatchLayout(const std::string& text);  // "consecutive" or "int
 // `wide`: a model with wide channel batches (ModelCapabilities::wide_channels;
 // deterministic, on the CPU backend) is prepared once for up to
 // kMaxWideChannels / 3 batches and evaluates all their channels per ray
-// (Model::PrepareWide, given `prepare` for the models that gather per-batch
-// tables: bruneton's batches still go through the CLI's table cache): the same
-// values bit for bit, the geometry computed once per ray instead of once per
-// batch. false: one model per batch of three, as every other model.
+// (Model::PrepareWide; bruneton precomputes all the channels at once): the
+// same values bit for bit, the geometry computed once per ray (and per texel
+// of the precomputation) instead of once per batch. false: one model per
+// batch of three, as every other model.
+//
+// `prepare_wide`: how a wide group's model is prepared. Empty: PrepareWide(
+// group) (the model's own precomputation of every channel; `prepare` is not
+// called). Else prepare_wide(group, model, prepare), which calls PrepareWide
+// itself: with `prepare` to gather each batch's tables through it (the CLI
+// does when its table cache holds every batch's tables), or without.
+using PrepareFunction = std::function<void(const AtmosphereParameters&, Model*)>;
+using WidePrepareFunction = std::function<void(const std::vector<AtmosphereParameters>& group,
+                                               Model* model, const PrepareFunction& prepare)>;
 struct SpectralBatching {
     BatchSeeds seeds = BatchSeeds::kDistinct;
     BatchLayout layout = BatchLayout::kInterleaved;
     bool wide = true;
+    WidePrepareFunction prepare_wide = nullptr;
 };
 // "wide" or "three" (--channel-batches) as SpectralBatching::wide.
 bool ParseChannelBatches(const std::string& text);
 // Whether a spectral run of `info`'s model takes the wide path now
 // (`batching.wide`, the capability, not Monte Carlo, the CPU backend).
 bool UsesWideBatches(const ModelInfo& info, SpectralBatching batching);
-constexpr SpectralBatching kPerWavelengthBatching{BatchSeeds::kSame, BatchLayout::kConsecutive,
-                                                  true};
+inline const SpectralBatching kPerWavelengthBatching{BatchSeeds::kSame, BatchLayout::kConsecutive,
+                                                     true};
 
 // The wavelength indices of each batch, ceil(N/3) batches of three; a batch short
 // of three repeats its last index (its extra channels are computed, not stored).
 std::vector<std::array<size_t, 3>> SpectralBatches(size_t wavelengths, BatchLayout layout);
 
-// Prepare()s a model for one batch's atmosphere (the CLI passes its PrepareModel).
-using PrepareFunction = std::function<void(const AtmosphereParameters&, Model*)>;
+// PrepareFunction (above): Prepare()s a model for one batch's atmosphere (the
+// CLI passes its PrepareModel).
 
 // Fails (atmos::Error) for models without a per-wavelength form (neural: its
 // inputs are not an atmosphere's coefficients). Preetham has its own (the CIE

@@ -177,6 +177,19 @@ std::string TableCacheKeyText(const Model& model, const std::map<std::string, st
     return os.str();
 }
 
+bool TableCacheHasEntry(const Model& model, const std::map<std::string, std::string>& given,
+                        const AtmosphereParameters& atmosphere,
+                        const TableCacheSettings& settings) {
+    if (settings.directory.empty() || !model.CanBake() || !model.Info().capabilities.precomputed) {
+        return false;
+    }
+    const std::string key = TableCacheKeyText(model, given, atmosphere);
+    const fs::path entry =
+        fs::path(settings.directory) / (model.Info().name + "-" + Fnv1aHex(HashText(key)));
+    std::error_code ec;
+    return fs::exists(entry / kManifest, ec);
+}
+
 TablePrepareResult PrepareWithTableCache(Model* model,
                                          const std::map<std::string, std::string>& given,
                                          const AtmosphereParameters& atmosphere,

@@ -66,6 +66,12 @@ TablePrepareResult PrepareWithTableCache(Model* model,
                                          const AtmosphereParameters& atmosphere,
                                          const TableCacheSettings& settings);
 
+// Whether the cache (enabled, for a model that can bake precomputed tables)
+// has a completed entry of `model`'s key for `atmosphere` (not checked: a
+// damaged one is rebuilt by PrepareWithTableCache).
+bool TableCacheHasEntry(const Model& model, const std::map<std::string, std::string>& given,
+                        const AtmosphereParameters& atmosphere, const TableCacheSettings& settings);
+
 // The identity of the code: a 64-bit FNV-1a hash (hex) of the file this
 // function was loaded from (the executable, or the Python module), computed
 // once per process; "unknown" when it cannot be read.

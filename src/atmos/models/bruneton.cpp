@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "atmos/error.h"
+#include "base/parallel.h"
 #include "io/gpu_passes.h"
 #include "io/output_path.h"
 #include "io/raw_tables.h"
@@ -149,10 +150,17 @@ void BrunetonModel::PrepareWide(const std::vector<AtmosphereParameters>& batches
                                 const BatchPrepare& prepare_batch) {
     if (!info_.capabilities.wide_channels) Model::PrepareWide(batches, prepare_batch);
     const WideCoefficients wide = MakeWideCoefficients(batches);
-    // The tables of each batch, as Prepare() computes them (or the spectral
-    // run's prepare function: the table cache, --load), side by side.
     BrunetonTables wide_tables;
-    for (size_t b = 0; b < batches.size(); ++b) {
+    const bool at_once = !prepare_batch && !IsDeviceBackend(CurrentBackend());
+    if (at_once) {
+        // One precomputation of every channel (bruneton_wide_precompute.cpp):
+        // the batches' tables bit for bit, each texel's geometry once.
+        for (const AtmosphereParameters& a : batches) WarnOutsideValidityDomain(Info(), a);
+        PrecomputeBrunetonWide(batches, config_, &wide_tables);
+    }
+    // Otherwise the tables of each batch, as Prepare() computes them (or the
+    // spectral run's prepare function: the table cache, --load), side by side.
+    for (size_t b = 0; !at_once && b < batches.size(); ++b) {
         BrunetonModel batch_model(config_);
         if (prepare_batch) {
             prepare_batch(batches[b], &batch_model);

@@ -812,6 +812,15 @@ using BrunetonOrderCallback =
 void PrecomputeBruneton(const AtmosphereParameters& atmosphere, const BrunetonConfig& config,
                         BrunetonTables* tables, const BrunetonOrderCallback& on_order = nullptr);
 
+// The precomputation of every batch of a wide group at once, on the CPU
+// (bruneton_wide_precompute.cpp): tables of n = 3 x batches.size() channels,
+// channel 3b + c = channel c of batch b's PrecomputeBruneton tables (the CPU
+// backend's), bit for bit; each texel's geometry computed once for all
+// channels. Separate Mie storage only; the batches as MakeWideCoefficients
+// takes them. Each stage's time is in the stage log ("bruneton wide ...").
+void PrecomputeBrunetonWide(const std::vector<AtmosphereParameters>& batches,
+                            const BrunetonConfig& config, BrunetonTables* tables);
+
 // Checks sizes and orders; throws atmos::Error naming the bad option.
 void ValidateBrunetonConfig(const BrunetonConfig& config);
 

@@ -219,11 +219,10 @@ void ComputeBrunetonMultipleScatteringRowsScalar(const BrunetonLut& lut, const T
 // (ATMOS_SIMD_WIDE) turns into vector code: the per-sample constants hoisted out of
 // the loop, the table lookups written out for the fixed 3-channel layout.
 
-namespace {
-
 // The row's (mu_s, nu) per texel, x = nu * MU_S + mu_s: RMuMuSNuFromTexel's
 // values, its mapping done once per mu_s column.
-void RowMuSNu(const BrunetonLut& lut, int y, int z, int width, double* mu_s_x, double* nu_x) {
+void BrunetonRowMuSNu(const BrunetonLut& lut, int y, int z, int width, double* mu_s_x,
+                      double* nu_x) {
     const int mu_s_size = lut.cfg.scattering_mu_s;
     double r, mu = 0.0, nu;
     bool ground;
@@ -235,8 +234,6 @@ void RowMuSNu(const BrunetonLut& lut, int y, int z, int width, double* mu_s_x, d
         nu_x[x] = BrunetonLut::ClampNu(lut.TexelNuUnclamped(x / mu_s_size), mu, mu_s_x[x]);
     }
 }
-
-}  // namespace
 
 // Single scattering: per sample, the transmittance to the sun at every texel of
 // the row (BrunetonSingleScatteringAdd: GetTransmittanceToSun, i.e. the sun
@@ -264,7 +261,7 @@ void ComputeBrunetonSingleScatteringRows(const BrunetonLut& lut, Table* rayleigh
         std::vector<double> texel(2 * wz);
         double* const mu_s_x = texel.data();
         double* const nu_x = mu_s_x + wz;
-        RowMuSNu(lut, y, z, width, mu_s_x, nu_x);
+        BrunetonRowMuSNu(lut, y, z, width, mu_s_x, nu_x);
         std::vector<float> acc(6 * wz, 0.0f);  // Rayleigh R, G, B, then Mie R, G, B
         float* const sr0 = acc.data();
         float* const sr1 = sr0 + wz;
@@ -364,7 +361,7 @@ void ComputeBrunetonMultipleScatteringRows(const BrunetonLut& lut, const TableVi
         double* const nu_x = mu_s_x + wz;
         double* const tex_x = nu_x + wz;
         std::vector<float> lerp_x(wz);
-        RowMuSNu(lut, y, z, width, mu_s_x, nu_x);
+        BrunetonRowMuSNu(lut, y, z, width, mu_s_x, nu_x);
         for (size_t k = 0; k < wz; ++k) {
             BrunetonNuCoordinate(nu_x[k], nu_size, &tex_x[k], &lerp_x[k]);
         }

@@ -686,6 +686,12 @@ void ComputeBrunetonSingleScatteringRowsScalar(const BrunetonLut& lut, Table* ra
 void ComputeBrunetonMultipleScatteringRowsScalar(const BrunetonLut& lut, const TableView& density,
                                                  Table* out);
 
+// The (mu_s, nu) of each texel of the scattering table's row (y, z) (x = nu *
+// MU_S + mu_s): RMuMuSNuFromTexel's values, the mapping done once per mu_s
+// column; the arrays hold NU * MU_S values.
+void BrunetonRowMuSNu(const BrunetonLut& lut, int y, int z, int width, double* mu_s_x,
+                      double* nu_x);
+
 // PrecomputeBruneton with the choice of per-texel stages made explicit:
 // `texel_stages` runs every stage through its stage struct (what the CUDA
 // backend does, and does on the CPU backend too); otherwise the CPU's row forms
