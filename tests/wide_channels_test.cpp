@@ -124,11 +124,21 @@ TEST_P(WideChannels, RenderAndSampleEqualTheThreeChannelBatchesBitForBit) {
     }
 }
 
+// Small tables, few steps: some view rays have optically thick steps in some
+// batches only (tests/atmosphere_plus_wide_test.cpp).
+const char* kSmallAtmospherePlus =
+    "atmosphere-plus:table-width=8:table-height=16:table-depth=8:transmittance-width=16:"
+    "transmittance-height=32:orders=3:gather-theta=6:gather-phi=12:transmittance-steps=10";
+
 INSTANTIATE_TEST_SUITE_P(Models, WideChannels,
                          ::testing::Values(kSmallBruneton, "naive", "naive:steps=7:light-steps=5",
-                                           kSmallHillaire, kSmallHillaireOtherPaths),
+                                           kSmallHillaire, kSmallHillaireOtherPaths,
+                                           kSmallAtmospherePlus),
                          [](const ::testing::TestParamInfo<const char*>& param) {
-                             return ParseModelSpec(param.param).name + std::to_string(param.index);
+                             // gtest names: letters, digits and '_' only.
+                             std::string name = ParseModelSpec(param.param).name;
+                             std::replace(name.begin(), name.end(), '-', '_');
+                             return name + std::to_string(param.index);
                          });
 
 TEST(WideChannelBatches, BrunetonPrecomputesAllChannelsOrGathersThroughThePrepareFunction) {

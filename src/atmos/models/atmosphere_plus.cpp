@@ -102,6 +102,7 @@ ModelInfo AtmospherePlusModel::StaticInfo() {
         "by gathering; phase functions at render time";
     info.capabilities.multiple_scattering = true;
     info.capabilities.precomputed = true;
+    info.capabilities.wide_channels = true;  // models/atmosphere_plus_wide.h
     info.options = OptionRows().Specs();
     info.capabilities.shader = "atmosphere_plus";
     info.capabilities.validity_notes = {

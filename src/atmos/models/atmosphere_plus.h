@@ -66,6 +66,7 @@
 #include "physics/geometry.h"
 #include "physics/phase.h"
 #include "physics/transmittance.h"
+#include "physics/wide.h"
 
 namespace atmos {
 
@@ -233,6 +234,25 @@ struct AplusTables {
 // table.
 AplusTables AplusPrecompute(const AtmosphereParameters& atm, const AplusSettings& settings,
                             bool keep_orders = false);
+
+// The tables of a wide precomputation (wide channel batches: physics/wide.h,
+// models/atmosphere_plus_wide.h) for n = 3B channels of B batches: per texel
+// the Rayleigh values of every channel (3b + c: batch b's channel c), then the
+// Mie value (alpha) of every batch (n + b), contiguous.
+struct AplusWideTables {
+    Table scattering;     // width x height x depth x (n + n / 3)
+    Table transmittance;  // transmittance_width x transmittance_height x 1 x n
+};
+
+// The tables for the batches' channels (MakeWideCoefficients: batch b gives
+// channels 3b .. 3b + 2; the batches differ only in those coefficients), on
+// the CPU (atmosphere_plus_wide.cpp): channel for channel what
+// AplusPrecompute(batches[b], settings) computes, bit for bit, with the
+// geometry shared by the channels and, in each (altitude, view) column of the
+// table, by its sun angles. Each batch's orders are checked as AplusPrecompute
+// checks them (a warning per batch whose orders stop decreasing).
+AplusWideTables AplusPrecomputeWide(const std::vector<AtmosphereParameters>& batches,
+                                    const AplusSettings& settings);
 
 // Texel i of a table of `size` texels holds the value at i / (size - 1) (seed
 // 000 2.4's x/(size-1); atmosphere_plus_mapping.h).
@@ -458,11 +478,28 @@ class AtmospherePlusModel : public EvaluatorModel<AtmospherePlusModel> {
     int64_t TableBytes() const override;
     void LoadBaked(const std::string& directory, const AtmosphereParameters& atmosphere) override;
 
+    // Wide channel batches (models/atmosphere_plus_wide.h): PrepareWide
+    // computes the n-channel tables itself (AplusPrecomputeWide; the spectral
+    // run's per-batch prepare function is not used).
+    void PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                     const BatchPrepare& prepare_batch = {}) override;
+    void RenderWide(const RenderRequest& request, std::vector<float>* values) const override;
+    std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
+    // The tables of the last PrepareWide (empty before).
+    const AplusWideTables& wide_tables() const { return wide_tables_; }
+
   private:
     ModelInfo info_;
     AplusSettings settings_;
     AtmosphereParameters atm_;
     AplusTables tables_;
+    // PrepareWide's: batch 0's atmosphere, the per-channel coefficients, the
+    // mapping (its radii set) and the tables.
+    bool wide_prepared_ = false;
+    AtmosphereParameters wide_atm_;
+    WideCoefficients wide_;
+    AplusMapping wide_mapping_;
+    AplusWideTables wide_tables_;
 };
 
 }  // namespace atmos
