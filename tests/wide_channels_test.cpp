@@ -126,7 +126,8 @@ TEST_P(WideChannels, RenderAndSampleEqualTheThreeChannelBatchesBitForBit) {
 
 INSTANTIATE_TEST_SUITE_P(Models, WideChannels,
                          ::testing::Values(kSmallBruneton, "naive", "naive:steps=7:light-steps=5",
-                                           kSmallHillaire, kSmallHillaireOtherPaths),
+                                           kSmallHillaire, kSmallHillaireOtherPaths, "oneil",
+                                           "oneil:fit=original:steps=3"),
                          [](const ::testing::TestParamInfo<const char*>& param) {
                              return ParseModelSpec(param.param).name + std::to_string(param.index);
                          });

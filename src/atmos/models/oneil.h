@@ -49,6 +49,8 @@
 // (no vertex interpolation), in double.
 #pragma once
 
+#include <vector>
+
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "models/analytic_ray.h"
@@ -57,6 +59,7 @@
 #include "physics/analytic_optical_depth.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
+#include "physics/wide.h"
 
 namespace atmos {
 
@@ -134,6 +137,58 @@ struct OneilEvaluator : AnalyticEvaluator<OneilEvaluator, OneilOptics> {
         return ClampLength(l);
     }
 
+    // The per-ray constants of the sample loop (Start) and each sample's
+    // geometry (SampleAt), shared by Integrate and the wide evaluator.
+    struct RayStart {
+        OneilRayStart r, m;  // Rayleigh's and Mie's segment-start lengths
+        double r0, mu0, camera_sun, dir_sun, ds;
+    };
+    ATMOS_HD RayStart Start(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                            const AtmosphereSegment& seg) const {
+        const AnalyticMedia& m = optics.m;
+        RayStart s;
+        const Vec3d p0 = camera + dir * seg.t_start;
+        s.r0 = Length(p0);
+        s.mu0 = ClampCosine(Dot(p0, dir) / s.r0);
+        const double mu0_abs = s.mu0 >= 0.0 ? s.mu0 : -s.mu0;
+        const double r_c0 = s.r0 * SafeSqrt(1.0 - s.mu0 * s.mu0);
+        s.r.f0 = optics.rayleigh.LengthToInfinity(s.r0, mu0_abs, m.bottom);
+        s.m.f0 = optics.mie.LengthToInfinity(s.r0, mu0_abs, m.bottom);
+        if (s.mu0 < 0.0) {
+            s.r.f_tangent = optics.rayleigh.LengthToInfinity(r_c0, 0.0, m.bottom);
+            s.m.f_tangent = optics.mie.LengthToInfinity(r_c0, 0.0, m.bottom);
+        }
+        s.camera_sun = Dot(camera, sun);
+        s.dir_sun = Dot(dir, sun);
+        s.ds = (seg.t_end - seg.t_start) / steps;
+        return s;
+    }
+    // Sample i's optical lengths (light + view) of Rayleigh and Mie and its
+    // weights rho ds.
+    struct Sample {
+        double l_r, l_m, w_r, w_m;
+    };
+    ATMOS_HD Sample SampleAt(const RayStart& s, const Vec3d& camera, const Vec3d& dir,
+                             const AtmosphereSegment& seg, int i) const {
+        const AnalyticMedia& m = optics.m;
+        const double t = seg.t_start + (i + 0.5) * s.ds;
+        const Vec3d p = camera + dir * t;
+        const double r = Length(p);
+        const double h = r - m.bottom;
+        const double rho_r = SafeExp(-h / m.rayleigh_H);
+        const double rho_m = SafeExp(-h / m.mie_H);
+        const double mu1 = ClampCosine((s.r0 * s.mu0 + (t - seg.t_start)) / Max(r, 1e-9));
+        const double mu_s = ClampCosine((s.camera_sun + t * s.dir_sun) / r);
+        Sample out;
+        out.l_r = ViewLength(optics.rayleigh, s.r, s.mu0, rho_r, mu1) +
+                  LightLength(optics.rayleigh, r, rho_r, mu_s);
+        out.l_m = ViewLength(optics.mie, s.m, s.mu0, rho_m, mu1) +
+                  LightLength(optics.mie, r, rho_m, mu_s);
+        out.w_r = rho_r * s.ds;
+        out.w_m = rho_m * s.ds;
+        return out;
+    }
+
     // O'Neil's loop with every exponential computed once: per sample, the two
     // densities (shared by the in-scattering term, the view segment's and the
     // light ray's optical lengths), scale() of the view and sun cosines, and
@@ -145,41 +200,110 @@ struct OneilEvaluator : AnalyticEvaluator<OneilEvaluator, OneilOptics> {
     ATMOS_HD void Integrate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                             bool want_ground, const AtmosphereSegment& seg, RayResult* out) const {
         const AnalyticMedia& m = optics.m;
-        const Vec3d p0 = camera + dir * seg.t_start;
-        const double r0 = Length(p0);
-        const double mu0 = ClampCosine(Dot(p0, dir) / r0);
-        const double mu0_abs = mu0 >= 0.0 ? mu0 : -mu0;
-        const double r_c0 = r0 * SafeSqrt(1.0 - mu0 * mu0);
-        OneilRayStart start_r, start_m;
-        start_r.f0 = optics.rayleigh.LengthToInfinity(r0, mu0_abs, m.bottom);
-        start_m.f0 = optics.mie.LengthToInfinity(r0, mu0_abs, m.bottom);
-        if (mu0 < 0.0) {
-            start_r.f_tangent = optics.rayleigh.LengthToInfinity(r_c0, 0.0, m.bottom);
-            start_m.f_tangent = optics.mie.LengthToInfinity(r_c0, 0.0, m.bottom);
-        }
-        const double camera_sun = Dot(camera, sun);
-        const double dir_sun = Dot(dir, sun);
-        const double ds = (seg.t_end - seg.t_start) / steps;
+        const RayStart s = Start(camera, dir, sun, seg);
         Vec3d sum_r, sum_m;
         for (int i = 0; i < steps; ++i) {
-            const double t = seg.t_start + (i + 0.5) * ds;
-            const Vec3d p = camera + dir * t;
-            const double r = Length(p);
-            const double h = r - m.bottom;
-            const double rho_r = SafeExp(-h / m.rayleigh_H);
-            const double rho_m = SafeExp(-h / m.mie_H);
-            const double mu1 = ClampCosine((r0 * mu0 + (t - seg.t_start)) / Max(r, 1e-9));
-            const double mu_s = ClampCosine((camera_sun + t * dir_sun) / r);
-            const double l_r = ViewLength(optics.rayleigh, start_r, mu0, rho_r, mu1) +
-                               LightLength(optics.rayleigh, r, rho_r, mu_s);
-            const double l_m = ViewLength(optics.mie, start_m, mu0, rho_m, mu1) +
-                               LightLength(optics.mie, r, rho_m, mu_s);
-            const Vec3d attenuation = Exp(-(m.rayleigh_scattering * l_r + m.mie_extinction * l_m));
-            sum_r += attenuation * (rho_r * ds);
-            sum_m += attenuation * (rho_m * ds);
+            const Sample x = SampleAt(s, camera, dir, seg, i);
+            const Vec3d attenuation =
+                Exp(-(m.rayleigh_scattering * x.l_r + m.mie_extinction * x.l_m));
+            sum_r += attenuation * x.w_r;
+            sum_m += attenuation * x.w_m;
         }
-        FinishAnalyticRay(optics, camera, dir, sun, seg, want_ground, dir_sun, sum_r, sum_m,
+        FinishAnalyticRay(optics, camera, dir, sun, seg, want_ground, s.dir_sun, sum_r, sum_m,
                           Exp(-optics.SegmentDepth(camera, dir, seg.t_start, seg.t_end)), out);
+    }
+};
+
+// The wide evaluator (physics/wide.h; docs/models/oneil.md "Wide channel
+// batches"): OneilEvaluator::Evaluate for every channel of a wide batch. The
+// clip, the segment start's lengths, each sample's position, densities, view
+// and sun cosines and scale() lengths (OneilEvaluator::SampleAt: 6 to 8
+// exponentials per sample, none per channel), the phase functions and the
+// segment's and the ground's light lengths once per ray; per channel the
+// optical depth beta_R l_R + beta_M l_M, its exponential and the two sums, in
+// contiguous loops over the channels. Each channel's operations are the
+// three-channel evaluator's, in its order (Exp per value, double sums): a
+// channel equals it bit for bit.
+struct OneilWideEvaluator {
+    OneilEvaluator narrow;  // batch 0's optics (the common scale() fits, heights, phase)
+    int channels = 0;
+    // Each batch's AnalyticMedia coefficients (MakeOneilOptics), channel 3b + c.
+    double rayleigh_scattering[kMaxWideChannels] = {};
+    double mie_scattering[kMaxWideChannels] = {};
+    double mie_extinction[kMaxWideChannels] = {};
+    double ground_albedo[kMaxWideChannels] = {};
+
+    ATMOS_HD int Channels() const { return channels; }
+
+    // AnalyticGround for every channel at ground point g, times t_view when
+    // given (else 1, as BeginAnalyticRay's Vec3d(1.0)).
+    ATMOS_HD void Ground(const Vec3d& g, const Vec3d& sun, const double* t_view,
+                         WideRayResult* out) const {
+        const OneilOptics& o = narrow.optics;
+        const int n = channels;
+        bool any[kMaxWideChannels / 3];
+        bool some = false;
+        for (int b = 0; b < n / 3; ++b) {
+            const double* a = ground_albedo + 3 * b;
+            any[b] = !(Max(a[0], Max(a[1], a[2])) <= 0.0);
+            some = some || any[b];
+        }
+        if (!some) return;
+        const double cos_sun = Dot(Normalize(g), sun);
+        if (cos_sun <= 0.0) return;
+        const double r = Length(g);
+        const double mu_s = ClampCosine(Dot(g, sun) / r);
+        const double l_r = o.ToInfinity(o.rayleigh, r, mu_s);
+        const double l_m = o.ToInfinity(o.mie, r, mu_s);
+        for (int c = 0; c < n; ++c) {
+            if (!any[c / 3]) continue;
+            const double v = ground_albedo[c] * (cos_sun / kPi) *
+                             Exp(-(rayleigh_scattering[c] * l_r + mie_extinction[c] * l_m)) *
+                             (t_view ? t_view[c] : 1.0);
+            out->ground[c] = static_cast<float>(v);
+        }
+    }
+
+    ATMOS_HD void EvaluateWide(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                               bool want_ground, WideRayResult* out) const {
+        const OneilOptics& o = narrow.optics;
+        const int n = channels;
+        for (int c = 0; c < n; ++c) {
+            out->sky[c] = 0.0f;
+            out->ground[c] = 0.0f;
+            out->transmittance[c] = 1.0f;
+        }
+        const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, o.m.bottom, o.m.top);
+        out->hits_ground = seg.hits_ground;
+        if (!seg.inside) {
+            if (want_ground && GroundAtCamera(seg)) Ground(camera, sun, nullptr, out);
+            return;
+        }
+        const OneilEvaluator::RayStart s = narrow.Start(camera, dir, sun, seg);
+        double sum_r[kMaxWideChannels], sum_m[kMaxWideChannels];
+        for (int c = 0; c < n; ++c) sum_r[c] = sum_m[c] = 0.0;
+        for (int i = 0; i < narrow.steps; ++i) {
+            const OneilEvaluator::Sample x = narrow.SampleAt(s, camera, dir, seg, i);
+            for (int c = 0; c < n; ++c) {
+                const double a = Exp(-(rayleigh_scattering[c] * x.l_r + mie_extinction[c] * x.l_m));
+                sum_r[c] += a * x.w_r;
+                sum_m[c] += a * x.w_m;
+            }
+        }
+        // FinishAnalyticRay, with OneilOptics::SegmentDepth's two lengths once.
+        const RaySegmentStart g = RaySegmentStartOf(camera, dir, seg.t_start, seg.t_end);
+        const double d_r =
+            SegmentFromToInfinity(OneilLength{o.rayleigh, o.m.bottom}, g.r, g.mu, g.d);
+        const double d_m = SegmentFromToInfinity(OneilLength{o.mie, o.m.bottom}, g.r, g.mu, g.d);
+        const double pr = RayleighPhase(s.dir_sun), pm = o.m.MiePhaseAt(s.dir_sun);
+        double t_view[kMaxWideChannels];
+        for (int c = 0; c < n; ++c) {
+            out->sky[c] = static_cast<float>(rayleigh_scattering[c] * sum_r[c] * pr +
+                                             mie_scattering[c] * sum_m[c] * pm);
+            t_view[c] = Exp(-(rayleigh_scattering[c] * d_r + mie_extinction[c] * d_m));
+            out->transmittance[c] = static_cast<float>(t_view[c]);
+        }
+        if (want_ground && seg.hits_ground) Ground(camera + dir * seg.t_end, sun, t_view, out);
     }
 };
 
@@ -199,8 +323,18 @@ class OneilModel : public SimpleEvaluatorModel<OneilModel, OneilEvaluator> {
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override;
 
+    // Wide channel batches (OneilWideEvaluator).
+    void PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                     const BatchPrepare& prepare_batch = {}) override;
+    void RenderWide(const RenderRequest& request, std::vector<float>* values) const override;
+    std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
+
   private:
     bool refit_ = true;
+    bool wide_prepared_ = false;
+    OneilWideEvaluator wide_;
+    AtmosphereParameters wide_atmosphere_;  // batch 0's (the common fields)
+    WideCoefficients wide_solar_;           // the batches' coefficients (solar irradiance)
 };
 
 }  // namespace atmos
