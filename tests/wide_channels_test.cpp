@@ -128,7 +128,8 @@ INSTANTIATE_TEST_SUITE_P(Models, WideChannels,
                          ::testing::Values(kSmallBruneton, "naive", "naive:steps=7:light-steps=5",
                                            kSmallHillaire, kSmallHillaireOtherPaths, "oneil",
                                            "oneil:fit=original:steps=3", "schuler",
-                                           "schuler:steps=5:chapman-unit=half-height"),
+                                           "schuler:steps=5:chapman-unit=half-height", "flat",
+                                           "raymarched", "raymarched:steps=3"),
                          [](const ::testing::TestParamInfo<const char*>& param) {
                              return ParseModelSpec(param.param).name + std::to_string(param.index);
                          });

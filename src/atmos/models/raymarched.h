@@ -23,6 +23,8 @@
 // the tangent point in Eq. 53, smooth planet shadow, fitted shell).
 #pragma once
 
+#include <vector>
+
 #include "atmos/model.h"
 #include "models/flat.h"
 
@@ -56,6 +58,64 @@ struct RaymarchedEvaluator : AnalyticEvaluator<RaymarchedEvaluator, FlatOptics> 
     }
 };
 
+// The wide evaluator (docs/models/raymarched.md "Wide channel batches"):
+// RaymarchedEvaluator::Integrate for every channel: each part's optical
+// lengths, the light rays' lengths at the parts' ends and the phase
+// functions once per ray; per channel the depths, LinearExpIntegral, the sums
+// and the transmittance, in the three-channel order: a channel equals it bit
+// for bit.
+struct RaymarchedWideEvaluator {
+    FlatWideMedia w;
+    int steps = 5;
+
+    ATMOS_HD int Channels() const { return w.channels; }
+
+    ATMOS_HD void EvaluateWide(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                               bool want_ground, WideRayResult* out) const {
+        AtmosphereSegment seg;
+        if (!w.Begin(camera, dir, sun, want_ground, out, &seg)) return;
+        const FlatOptics& o = w.optics;
+        const int n = w.channels;
+        const double dt = (seg.t_end - seg.t_start) / steps;
+        double tau_view[kMaxWideChannels], light_a[kMaxWideChannels], sum_r[kMaxWideChannels],
+            sum_m[kMaxWideChannels];
+        const MediaLengths la = o.LightLengths(camera + dir * seg.t_start, sun);
+        for (int c = 0; c < n; ++c) {
+            tau_view[c] = sum_r[c] = sum_m[c] = 0.0;
+            light_a[c] = w.Ext(c, la);
+        }
+        for (int i = 0; i < steps; ++i) {
+            const double ta = seg.t_start + i * dt;
+            const double tb = (i + 1 == steps) ? seg.t_end : ta + dt;
+            const MediaLengths l = o.SegmentLengths(camera, dir, ta, tb);
+            const MediaLengths lb = o.LightLengths(camera + dir * tb, sun);
+            for (int c = 0; c < n; ++c) {
+                const double tau_i = w.Ext(c, l);
+                const double light_b = w.Ext(c, lb);
+                const double e =
+                    LinearExpIntegral(tau_view[c] + light_a[c], tau_view[c] + tau_i + light_b);
+                sum_r[c] += e * l.rayleigh;
+                sum_m[c] += e * l.mie;
+                tau_view[c] += tau_i;
+                light_a[c] = light_b;
+            }
+        }
+        // FinishAnalyticRay.
+        const double nu = Dot(dir, sun);
+        const double pr = RayleighPhase(nu), pm = o.m.MiePhaseAt(nu);
+        double t_view[kMaxWideChannels];
+        for (int c = 0; c < n; ++c) {
+            out->sky[c] = static_cast<float>(w.rayleigh_scattering[c] * sum_r[c] * pr +
+                                             w.mie_scattering[c] * sum_m[c] * pm);
+            t_view[c] = Exp(-tau_view[c]);
+            out->transmittance[c] = static_cast<float>(t_view[c]);
+        }
+        if (want_ground && seg.hits_ground) {
+            w.Ground(camera + dir * seg.t_end, sun, nullptr, t_view, out);
+        }
+    }
+};
+
 struct RaymarchedOptions {
     int steps = 5;  // view-ray segments
 };
@@ -66,6 +126,18 @@ class RaymarchedModel : public SimpleEvaluatorModel<RaymarchedModel, RaymarchedE
     explicit RaymarchedModel(const RaymarchedOptions& options);
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override;
+
+    // Wide channel batches (RaymarchedWideEvaluator).
+    void PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                     const BatchPrepare& prepare_batch = {}) override;
+    void RenderWide(const RenderRequest& request, std::vector<float>* values) const override;
+    std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
+
+  private:
+    bool wide_prepared_ = false;
+    RaymarchedWideEvaluator wide_;
+    AtmosphereParameters wide_atmosphere_;  // batch 0's (the common fields)
+    WideCoefficients wide_solar_;           // the batches' coefficients (solar irradiance)
 };
 
 }  // namespace atmos
