@@ -113,8 +113,10 @@ struct OneilRayStart {
 // (physics/vector_exp.h: "inline-unit-growth limit reached") and the loop
 // stays a scalar call per value; `flatten` inlines it into the loop
 // whatever the unit, so every copy of the loop is the vector one.
+// Nothing under nvcc (on the device these loops are plain scalar code, best
+// inlined; nvcc's front end need not take `flatten`).
 #if defined(__CUDACC__)
-#define ATMOS_LANE_LOOP __noinline__
+#define ATMOS_LANE_LOOP
 #elif defined(__GNUC__)
 #define ATMOS_LANE_LOOP __attribute__((noinline, flatten))
 #else
