@@ -308,11 +308,14 @@ struct OneilEvaluator : AnalyticEvaluator<OneilEvaluator, OneilOptics> {
     // O'Neil's loop with every exponential computed once: per sample, the two
     // densities (shared by the in-scattering term, the view segment's and the
     // light ray's optical lengths), scale() of the view and sun cosines, and
-    // the attenuation; the segment start's lengths once per ray. The view
+    // the attenuation; the segment start's lengths once per ray (Start, which
+    // also gives the whole segment's lengths for the transmittance). The view
     // segment's end is evaluated at the sample's own radius |p| (the generic
     // SegmentDepth recomputes it from the segment's start: the same radius up
-    // to rounding, results within ~1e-13 relative; tests/oneil_test.cpp holds
-    // this loop against the generic one).
+    // to rounding, results within ~1e-13 relative;
+    // Oneil.HoistedLoopMatchesTheGenericOne in tests/analytic_test.cpp holds
+    // this loop against the generic one). Every exponential is ExpLane, in
+    // the vector loops of SampleBlock, Start and OneilExpNegLanes.
     ATMOS_HD void Integrate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                             bool want_ground, const AtmosphereSegment& seg, RayResult* out) const {
         const AnalyticMedia& m = optics.m;
