@@ -55,6 +55,7 @@
 #include "atmos/model.h"
 #include "models/analytic_ray.h"
 #include "models/evaluator_model.h"
+#include "models/lane_loops.h"
 #include "physics/analytic_media.h"
 #include "physics/analytic_optical_depth.h"
 #include "physics/geometry.h"
@@ -108,30 +109,10 @@ struct OneilRayStart {
     double scale0 = 0.0;     // scale(0) (the light rays' tangent points)
 };
 
-// The vector loops of the evaluators below (ATMOS_LANE_LOOP): out of line
-// and flattened. In a large translation unit GCC stops inlining ExpPoly
-// (physics/vector_exp.h: "inline-unit-growth limit reached") and the loop
-// stays a scalar call per value; `flatten` inlines it into the loop
-// whatever the unit, so every copy of the loop is the vector one.
-// Nothing under nvcc (on the device these loops are plain scalar code, best
-// inlined; nvcc's front end need not take `flatten`).
-#if defined(__CUDACC__)
-#define ATMOS_LANE_LOOP
-#elif defined(__GNUC__)
-#define ATMOS_LANE_LOOP __attribute__((noinline, flatten))
-#else
-#define ATMOS_LANE_LOOP
-#endif
-
 // x[i] = SafeExp(x[i]) (physics/analytic_optical_depth.h) on ExpLane.
 ATMOS_HD ATMOS_LANE_LOOP inline void OneilSafeExpLanes(double* __restrict__ x, int n) {
     ATMOS_SIMD
     for (int i = 0; i < n; ++i) x[i] = ExpLane(Clamp(x[i], -700.0, 60.0));
-}
-// x[i] = exp(-x[i]) on ExpLane.
-ATMOS_HD ATMOS_LANE_LOOP inline void OneilExpNegLanes(double* __restrict__ x, int n) {
-    ATMOS_SIMD
-    for (int i = 0; i < n; ++i) x[i] = ExpLane(-x[i]);
 }
 // One sample of n channels: the attenuation exp(-(a l_r + b l_m)) per
 // channel (a, b: the Rayleigh scattering and Mie extinction coefficients)
@@ -315,7 +296,7 @@ struct OneilEvaluator : AnalyticEvaluator<OneilEvaluator, OneilOptics> {
     // to rounding, results within ~1e-13 relative;
     // Oneil.HoistedLoopMatchesTheGenericOne in tests/analytic_test.cpp holds
     // this loop against the generic one). Every exponential is ExpLane, in
-    // the vector loops of SampleBlock, Start and OneilExpNegLanes.
+    // the vector loops of SampleBlock, Start and ExpNegLanes.
     ATMOS_HD void Integrate(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                             bool want_ground, const AtmosphereSegment& seg, RayResult* out) const {
         const AnalyticMedia& m = optics.m;
@@ -332,7 +313,7 @@ struct OneilEvaluator : AnalyticEvaluator<OneilEvaluator, OneilOptics> {
                 tau[3 * k + 1] = t.y;
                 tau[3 * k + 2] = t.z;
             }
-            OneilExpNegLanes(tau, 3 * lanes);
+            ExpNegLanes(tau, 3 * lanes);
             for (int k = 0; k < lanes; ++k) {
                 const Vec3d attenuation(tau[3 * k], tau[3 * k + 1], tau[3 * k + 2]);
                 sum_r += attenuation * x.w_r[k];
@@ -341,7 +322,7 @@ struct OneilEvaluator : AnalyticEvaluator<OneilEvaluator, OneilOptics> {
         }
         const Vec3d depth = m.rayleigh_scattering * s.depth_r + m.mie_extinction * s.depth_m;
         double t_view[3] = {depth.x, depth.y, depth.z};
-        OneilExpNegLanes(t_view, 3);
+        ExpNegLanes(t_view, 3);
         FinishAnalyticRay(optics, camera, dir, sun, seg, want_ground, s.dir_sun, sum_r, sum_m,
                           Vec3d(t_view[0], t_view[1], t_view[2]), out);
     }
@@ -434,7 +415,7 @@ struct OneilWideEvaluator {
                                              mie_scattering[c] * sum_m[c] * pm);
             t_view[c] = rayleigh_scattering[c] * d_r + mie_extinction[c] * d_m;
         }
-        OneilExpNegLanes(t_view, n);
+        ExpNegLanes(t_view, n);
         for (int c = 0; c < n; ++c) out->transmittance[c] = static_cast<float>(t_view[c]);
         if (want_ground && seg.hits_ground) Ground(camera + dir * seg.t_end, sun, t_view, out);
     }
