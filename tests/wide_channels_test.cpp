@@ -133,7 +133,10 @@ const char* kSmallAtmospherePlus =
 INSTANTIATE_TEST_SUITE_P(Models, WideChannels,
                          ::testing::Values(kSmallBruneton, "naive", "naive:steps=7:light-steps=5",
                                            kSmallHillaire, kSmallHillaireOtherPaths,
-                                           kSmallAtmospherePlus),
+                                           kSmallAtmospherePlus, "oneil",
+                                           "oneil:fit=original:steps=3", "schuler",
+                                           "schuler:steps=5:chapman-unit=half-height", "flat",
+                                           "raymarched", "raymarched:steps=3"),
                          [](const ::testing::TestParamInfo<const char*>& param) {
                              // gtest names: letters, digits and '_' only.
                              std::string name = ParseModelSpec(param.param).name;

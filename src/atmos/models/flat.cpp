@@ -1,5 +1,8 @@
 #include "models/flat.h"
 
+#include "atmos/error.h"
+#include "render/wide.h"
+
 namespace atmos {
 
 ModelInfo FlatModel::StaticInfo() {
@@ -12,6 +15,7 @@ ModelInfo FlatModel::StaticInfo() {
     info.summary =
         "closed-form single scattering over one segment, homogeneous-sphere optical depth, "
         "ozone shell";
+    info.capabilities.wide_channels = true;
     info.thesis_name = "Flat";
     info.thesis_lines = 58;
     return info;
@@ -22,6 +26,48 @@ FlatModel::FlatModel(const NoOptions&) { Prepare(EarthAtmosphere()); }
 void FlatModel::Prepare(const AtmosphereParameters& atmosphere) {
     SetAtmosphere(atmosphere);
     evaluator_.optics.m = MakeAnalyticMedia(atmosphere);
+}
+
+FlatWideMedia MakeFlatWideMedia(const std::vector<AtmosphereParameters>& batches) {
+    MakeWideCoefficients(batches);  // the batches differ only in their coefficients
+    FlatWideMedia w;
+    w.optics.m = MakeAnalyticMedia(batches[0]);
+    w.channels = static_cast<int>(batches.size()) * 3;
+    for (size_t b = 0; b < batches.size(); ++b) {
+        const AnalyticMedia m = MakeAnalyticMedia(batches[b]);
+        // The shell's geometry is the absorption profile's; a batch without
+        // absorption has none (and a 0 coefficient).
+        if (w.optics.m.ozone.Empty() && !m.ozone.Empty()) w.optics.m.ozone = m.ozone;
+        for (int c = 0; c < 3; ++c) {
+            const size_t k = 3 * b + static_cast<size_t>(c);
+            w.rayleigh_scattering[k] = m.rayleigh_scattering[c];
+            w.mie_scattering[k] = m.mie_scattering[c];
+            w.mie_extinction[k] = m.mie_extinction[c];
+            w.ozone_absorption[k] = m.ozone_absorption[c];
+            w.ground_albedo[k] = m.ground_albedo[c];
+        }
+    }
+    return w;
+}
+
+void FlatModel::PrepareWide(const std::vector<AtmosphereParameters>& batches, const BatchPrepare&) {
+    // No tables: each batch's Prepare() is its AnalyticMedia, made here.
+    wide_solar_ = MakeWideCoefficients(batches);
+    for (const AtmosphereParameters& a : batches) WarnOutsideValidityDomain(Info(), a);
+    wide_ = FlatWideEvaluator();
+    wide_.w = MakeFlatWideMedia(batches);
+    wide_atmosphere_ = batches[0];
+    wide_prepared_ = true;
+}
+
+void FlatModel::RenderWide(const RenderRequest& request, std::vector<float>* values) const {
+    if (!wide_prepared_) Fail("model flat: PrepareWide() must run before RenderWide()");
+    RenderWideImage(wide_, MakeWidePixelSetup(request, wide_atmosphere_, wide_solar_), values);
+}
+
+std::vector<float> FlatModel::SampleWide(const std::vector<SampleQuery>& queries) const {
+    if (!wide_prepared_) Fail("model flat: PrepareWide() must run before SampleWide()");
+    return SampleAllWide(wide_, wide_atmosphere_.bottom_radius, queries);
 }
 
 }  // namespace atmos

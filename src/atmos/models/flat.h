@@ -33,6 +33,8 @@
 // column and centroid (physics/analytic_media.h).
 #pragma once
 
+#include <vector>
+
 #include "atmos/atmosphere.h"
 #include "atmos/model.h"
 #include "models/analytic_ray.h"
@@ -41,6 +43,7 @@
 #include "physics/analytic_optical_depth.h"
 #include "physics/geometry.h"
 #include "physics/phase.h"
+#include "physics/wide.h"
 
 namespace atmos {
 
@@ -74,14 +77,83 @@ struct FlatOptics {
     // Optical depth from p toward the sun to infinity (Eq. 51, or Eq. 53 for
     // a sun below the local horizon), ozone shell included.
     ATMOS_HD Vec3d LightDepth(const Vec3d& p, const Vec3d& sun) const {
+        const MediaLengths l = LightLengths(p, sun);
+        return m.Extinction(l.rayleigh, l.mie, l.ozone);
+    }
+    // The three media's optical lengths of LightDepth.
+    ATMOS_HD MediaLengths LightLengths(const Vec3d& p, const Vec3d& sun) const {
         const double r = Length(p);
         const double mu_s = ClampCosine(Dot(p, sun) / r);
-        const double l_r = FlatLengthToInfinity(r, mu_s, m.rayleigh_H, m.bottom);
-        const double l_m = FlatLengthToInfinity(r, mu_s, m.mie_H, m.bottom);
-        const double l_o = ShellLength(m.ozone, p, sun, 0.0, 4.0 * m.top);
-        return m.Extinction(l_r, l_m, l_o);
+        MediaLengths l;
+        l.rayleigh = FlatLengthToInfinity(r, mu_s, m.rayleigh_H, m.bottom);
+        l.mie = FlatLengthToInfinity(r, mu_s, m.mie_H, m.bottom);
+        l.ozone = ShellLength(m.ozone, p, sun, 0.0, 4.0 * m.top);
+        return l;
     }
 };
+
+// The per-channel coefficients of a wide batch of FlatOptics (flat and
+// raymarched, physics/wide.h): each batch's AnalyticMedia coefficients side
+// by side (channel 3b + c) and one FlatOptics for the geometry (the heights
+// and the ozone shell, which do not depend on the coefficients: a batch
+// whose shell is empty, no absorption at its wavelengths, has 0 for its
+// ozone coefficient, so that its channels' depths are the same numbers).
+struct FlatWideMedia {
+    FlatOptics optics;
+    int channels = 0;
+    double rayleigh_scattering[kMaxWideChannels] = {};
+    double mie_scattering[kMaxWideChannels] = {};
+    double mie_extinction[kMaxWideChannels] = {};
+    double ozone_absorption[kMaxWideChannels] = {};
+    double ground_albedo[kMaxWideChannels] = {};
+
+    // AnalyticMedia::Extinction of channel c.
+    ATMOS_HD double Ext(int c, const MediaLengths& l) const {
+        return rayleigh_scattering[c] * l.rayleigh + mie_extinction[c] * l.mie +
+               ozone_absorption[c] * l.ozone;
+    }
+    // AnalyticGround (models/analytic_ray.h) of every channel at ground point
+    // g, with LightLengths(g) given, times t_view when given.
+    ATMOS_HD void Ground(const Vec3d& g, const Vec3d& sun, const MediaLengths* light,
+                         const double* t_view, WideRayResult* out) const {
+        const int n = channels;
+        const double cos_sun = Dot(Normalize(g), sun);
+        MediaLengths l;
+        bool have = light != nullptr;
+        if (have) l = *light;
+        for (int b = 0; b < n / 3; ++b) {
+            const double* a = ground_albedo + 3 * b;
+            if (Max(a[0], Max(a[1], a[2])) <= 0.0 || cos_sun <= 0.0) continue;
+            if (!have) {
+                l = optics.LightLengths(g, sun);
+                have = true;
+            }
+            for (int c = 3 * b; c < 3 * b + 3; ++c) {
+                const double v = ground_albedo[c] * (cos_sun / kPi) * Exp(-Ext(c, l)) *
+                                 (t_view ? t_view[c] : 1.0);
+                out->ground[c] = static_cast<float>(v);
+            }
+        }
+    }
+    // Clears out and clips the ray (BeginAnalyticRay); false when it misses
+    // the atmosphere (the ground at the camera done).
+    ATMOS_HD bool Begin(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun, bool want_ground,
+                        WideRayResult* out, AtmosphereSegment* seg) const {
+        for (int c = 0; c < channels; ++c) {
+            out->sky[c] = 0.0f;
+            out->ground[c] = 0.0f;
+            out->transmittance[c] = 1.0f;
+        }
+        *seg = ClipToAtmosphere(camera, dir, optics.m.bottom, optics.m.top);
+        out->hits_ground = seg->hits_ground;
+        if (seg->inside) return true;
+        if (want_ground && GroundAtCamera(*seg)) Ground(camera, sun, nullptr, nullptr, out);
+        return false;
+    }
+};
+
+// FlatWideMedia for the batches (throws as MakeWideCoefficients).
+FlatWideMedia MakeFlatWideMedia(const std::vector<AtmosphereParameters>& batches);
 
 struct FlatEvaluator : AnalyticEvaluator<FlatEvaluator, FlatOptics> {
     // The segment inside the atmosphere (AnalyticEvaluator::Evaluate).
@@ -106,12 +178,61 @@ struct FlatEvaluator : AnalyticEvaluator<FlatEvaluator, FlatOptics> {
     }
 };
 
+// The wide evaluator (docs/models/flat.md "Wide channel batches"):
+// FlatEvaluator::Integrate for every channel: the segment's and the two light
+// rays' optical lengths and the phase functions once per ray, per channel the
+// depths, LinearExpIntegral and the transmittance, in the three-channel
+// order: a channel equals it bit for bit.
+struct FlatWideEvaluator {
+    FlatWideMedia w;
+
+    ATMOS_HD int Channels() const { return w.channels; }
+
+    ATMOS_HD void EvaluateWide(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                               bool want_ground, WideRayResult* out) const {
+        AtmosphereSegment seg;
+        if (!w.Begin(camera, dir, sun, want_ground, out, &seg)) return;
+        const FlatOptics& o = w.optics;
+        const MediaLengths l = o.SegmentLengths(camera, dir, seg.t_start, seg.t_end);
+        const Vec3d p0 = camera + dir * seg.t_start;
+        const Vec3d p1 = camera + dir * seg.t_end;
+        const MediaLengths light0 = o.LightLengths(p0, sun);
+        const MediaLengths light1 = o.LightLengths(p1, sun);
+        const double nu = Dot(dir, sun);
+        const double lr = l.rayleigh * RayleighPhase(nu), lm = l.mie * o.m.MiePhaseAt(nu);
+        double t_view[kMaxWideChannels];
+        for (int c = 0; c < w.channels; ++c) {
+            const double tau = w.Ext(c, l);
+            const double t0 = w.Ext(c, light0);
+            const double t1 = tau + w.Ext(c, light1);
+            const double e = LinearExpIntegral(t0, t1);
+            out->sky[c] =
+                static_cast<float>((w.rayleigh_scattering[c] * lr + w.mie_scattering[c] * lm) * e);
+            t_view[c] = Exp(-tau);
+            out->transmittance[c] = static_cast<float>(t_view[c]);
+        }
+        if (want_ground && seg.hits_ground) w.Ground(p1, sun, &light1, t_view, out);
+    }
+};
+
 class FlatModel : public SimpleEvaluatorModel<FlatModel, FlatEvaluator> {
   public:
     static const OptionTable<NoOptions>& OptionRows() { return NoOptionTable(); }
     explicit FlatModel(const NoOptions& options);
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override;
+
+    // Wide channel batches (FlatWideEvaluator).
+    void PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                     const BatchPrepare& prepare_batch = {}) override;
+    void RenderWide(const RenderRequest& request, std::vector<float>* values) const override;
+    std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
+
+  private:
+    bool wide_prepared_ = false;
+    FlatWideEvaluator wide_;
+    AtmosphereParameters wide_atmosphere_;  // batch 0's (the common fields)
+    WideCoefficients wide_solar_;           // the batches' coefficients (solar irradiance)
 };
 
 }  // namespace atmos

@@ -1,6 +1,8 @@
 #include "models/oneil.h"
 
+#include "atmos/error.h"
 #include "physics/analytic_fit.h"
+#include "render/wide.h"
 
 namespace atmos {
 
@@ -34,6 +36,7 @@ ModelInfo OneilModel::StaticInfo() {
         "single scattering, midpoint rule with the fitted scale() optical depth; scale() "
         "refitted per atmosphere in Prepare(); no ozone";
     info.capabilities.precomputed = true;
+    info.capabilities.wide_channels = true;
     info.options = OptionRows().Specs();
     // Measured: the zenith transmittance from the ground against its own at
     // Earth (docs/models/oneil.md "Validity domain"): -1.3 % at a planet of
@@ -65,6 +68,44 @@ OneilModel::OneilModel(const OneilOptions& options) {
 void OneilModel::Prepare(const AtmosphereParameters& atmosphere) {
     SetAtmosphere(atmosphere);
     evaluator_.optics = MakeOneilOptics(atmosphere, refit_);
+}
+
+void OneilModel::PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                             const BatchPrepare&) {
+    // No tables: each batch's Prepare() is its scale() fit and coefficients,
+    // made here. The batches share everything but the coefficients
+    // (MakeWideCoefficients checks), so the fits are batch 0's.
+    const WideCoefficients coefficients = MakeWideCoefficients(batches);
+    for (const AtmosphereParameters& a : batches) WarnOutsideValidityDomain(Info(), a);
+    wide_ = OneilWideEvaluator();
+    wide_.narrow = evaluator_;
+    wide_.narrow.optics = MakeOneilOptics(batches[0], refit_);
+    wide_.channels = static_cast<int>(batches.size()) * 3;
+    for (size_t b = 0; b < batches.size(); ++b) {
+        // MakeOneilOptics's coefficients (its fit changes only scale() and
+        // the heights, common to the batches).
+        const AnalyticMedia m = MakeAnalyticMedia(batches[b]);
+        for (int c = 0; c < 3; ++c) {
+            const size_t k = 3 * b + static_cast<size_t>(c);
+            wide_.rayleigh_scattering[k] = m.rayleigh_scattering[c];
+            wide_.mie_scattering[k] = m.mie_scattering[c];
+            wide_.mie_extinction[k] = m.mie_extinction[c];
+            wide_.ground_albedo[k] = m.ground_albedo[c];
+        }
+    }
+    wide_atmosphere_ = batches[0];
+    wide_solar_ = coefficients;
+    wide_prepared_ = true;
+}
+
+void OneilModel::RenderWide(const RenderRequest& request, std::vector<float>* values) const {
+    if (!wide_prepared_) Fail("model oneil: PrepareWide() must run before RenderWide()");
+    RenderWideImage(wide_, MakeWidePixelSetup(request, wide_atmosphere_, wide_solar_), values);
+}
+
+std::vector<float> OneilModel::SampleWide(const std::vector<SampleQuery>& queries) const {
+    if (!wide_prepared_) Fail("model oneil: PrepareWide() must run before SampleWide()");
+    return SampleAllWide(wide_, wide_atmosphere_.bottom_radius, queries);
 }
 
 }  // namespace atmos

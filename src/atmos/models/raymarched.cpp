@@ -1,5 +1,8 @@
 #include "models/raymarched.h"
 
+#include "atmos/error.h"
+#include "render/wide.h"
+
 namespace atmos {
 
 ModelInfo RaymarchedModel::StaticInfo() {
@@ -10,6 +13,7 @@ ModelInfo RaymarchedModel::StaticInfo() {
     info.summary =
         "single scattering summed over a few closed-form segments (Eq. 55), flat optical "
         "depth, ozone shell";
+    info.capabilities.wide_channels = true;
     info.options = OptionRows().Specs();
     info.thesis_name = "Raymarched";
     info.thesis_lines = 74;
@@ -30,6 +34,28 @@ RaymarchedModel::RaymarchedModel(const RaymarchedOptions& options) {
 void RaymarchedModel::Prepare(const AtmosphereParameters& atmosphere) {
     SetAtmosphere(atmosphere);
     evaluator_.optics.m = MakeAnalyticMedia(atmosphere);
+}
+
+void RaymarchedModel::PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                                  const BatchPrepare&) {
+    // No tables: each batch's Prepare() is its AnalyticMedia, made here.
+    wide_solar_ = MakeWideCoefficients(batches);
+    for (const AtmosphereParameters& a : batches) WarnOutsideValidityDomain(Info(), a);
+    wide_ = RaymarchedWideEvaluator();
+    wide_.steps = evaluator_.steps;
+    wide_.w = MakeFlatWideMedia(batches);
+    wide_atmosphere_ = batches[0];
+    wide_prepared_ = true;
+}
+
+void RaymarchedModel::RenderWide(const RenderRequest& request, std::vector<float>* values) const {
+    if (!wide_prepared_) Fail("model raymarched: PrepareWide() must run before RenderWide()");
+    RenderWideImage(wide_, MakeWidePixelSetup(request, wide_atmosphere_, wide_solar_), values);
+}
+
+std::vector<float> RaymarchedModel::SampleWide(const std::vector<SampleQuery>& queries) const {
+    if (!wide_prepared_) Fail("model raymarched: PrepareWide() must run before SampleWide()");
+    return SampleAllWide(wide_, wide_atmosphere_.bottom_radius, queries);
 }
 
 }  // namespace atmos

@@ -23,10 +23,34 @@
 // the tangent point in Eq. 53, smooth planet shadow, fitted shell).
 #pragma once
 
+#include <vector>
+
 #include "atmos/model.h"
 #include "models/flat.h"
 
 namespace atmos {
+
+// LinearExpIntegral (physics/analytic_media.h) along the chain of parts,
+// whose exponent at a part's start, tau_view + light_a, is the previous
+// part's at its end, tau_view + tau_i + light_b, as the same sum of the same
+// numbers (bit for bit): exp(-b) of one part is exp(-a) of the next, one
+// exponential per part instead of two, the same values.
+struct ChainedExpIntegral {
+    double exp_a = 0.0;  // exp(-a) of the next part, where have
+    bool have = false;
+    ATMOS_HD double Next(double a, double b) {
+        const double ea = have ? exp_a : Exp(-a);
+        const double d = b - a;
+        if (Abs(d) < 1e-6) {
+            have = false;
+            return ea * (1.0 - 0.5 * d);
+        }
+        const double eb = Exp(-b);
+        exp_a = eb;
+        have = true;
+        return (ea - eb) / d;
+    }
+};
 
 struct RaymarchedEvaluator : AnalyticEvaluator<RaymarchedEvaluator, FlatOptics> {
     int steps = 5;
@@ -39,13 +63,16 @@ struct RaymarchedEvaluator : AnalyticEvaluator<RaymarchedEvaluator, FlatOptics> 
         Vec3d tau_view;  // camera to the start of the current part
         Vec3d light_a = optics.LightDepth(camera + dir * seg.t_start, sun);
         Vec3d sum_r, sum_m;
+        ChainedExpIntegral chain[3];
         for (int i = 0; i < steps; ++i) {
             const double ta = seg.t_start + i * dt;
             const double tb = (i + 1 == steps) ? seg.t_end : ta + dt;
             const MediaLengths l = optics.SegmentLengths(camera, dir, ta, tb);
             const Vec3d tau_i = m.Extinction(l.rayleigh, l.mie, l.ozone);
             const Vec3d light_b = optics.LightDepth(camera + dir * tb, sun);
-            const Vec3d e = LinearExpIntegral(tau_view + light_a, tau_view + tau_i + light_b);
+            const Vec3d a = tau_view + light_a, b = tau_view + tau_i + light_b;
+            const Vec3d e(chain[0].Next(a.x, b.x), chain[1].Next(a.y, b.y),
+                          chain[2].Next(a.z, b.z));
             sum_r += e * l.rayleigh;
             sum_m += e * l.mie;
             tau_view += tau_i;
@@ -53,6 +80,65 @@ struct RaymarchedEvaluator : AnalyticEvaluator<RaymarchedEvaluator, FlatOptics> 
         }
         FinishAnalyticRay(optics, camera, dir, sun, seg, want_ground, Dot(dir, sun), sum_r, sum_m,
                           Exp(-tau_view), out);
+    }
+};
+
+// The wide evaluator (docs/models/raymarched.md "Wide channel batches"):
+// RaymarchedEvaluator::Integrate for every channel: each part's optical
+// lengths, the light rays' lengths at the parts' ends and the phase
+// functions once per ray; per channel the depths, LinearExpIntegral
+// (ChainedExpIntegral), the sums and the transmittance, in the three-channel
+// order: a channel equals it bit for bit.
+struct RaymarchedWideEvaluator {
+    FlatWideMedia w;
+    int steps = 5;
+
+    ATMOS_HD int Channels() const { return w.channels; }
+
+    ATMOS_HD void EvaluateWide(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
+                               bool want_ground, WideRayResult* out) const {
+        AtmosphereSegment seg;
+        if (!w.Begin(camera, dir, sun, want_ground, out, &seg)) return;
+        const FlatOptics& o = w.optics;
+        const int n = w.channels;
+        const double dt = (seg.t_end - seg.t_start) / steps;
+        double tau_view[kMaxWideChannels], light_a[kMaxWideChannels], sum_r[kMaxWideChannels],
+            sum_m[kMaxWideChannels];
+        ChainedExpIntegral chain[kMaxWideChannels];
+        const MediaLengths la = o.LightLengths(camera + dir * seg.t_start, sun);
+        for (int c = 0; c < n; ++c) {
+            tau_view[c] = sum_r[c] = sum_m[c] = 0.0;
+            light_a[c] = w.Ext(c, la);
+        }
+        for (int i = 0; i < steps; ++i) {
+            const double ta = seg.t_start + i * dt;
+            const double tb = (i + 1 == steps) ? seg.t_end : ta + dt;
+            const MediaLengths l = o.SegmentLengths(camera, dir, ta, tb);
+            const MediaLengths lb = o.LightLengths(camera + dir * tb, sun);
+            for (int c = 0; c < n; ++c) {
+                const double tau_i = w.Ext(c, l);
+                const double light_b = w.Ext(c, lb);
+                const double e =
+                    chain[c].Next(tau_view[c] + light_a[c], tau_view[c] + tau_i + light_b);
+                sum_r[c] += e * l.rayleigh;
+                sum_m[c] += e * l.mie;
+                tau_view[c] += tau_i;
+                light_a[c] = light_b;
+            }
+        }
+        // FinishAnalyticRay.
+        const double nu = Dot(dir, sun);
+        const double pr = RayleighPhase(nu), pm = o.m.MiePhaseAt(nu);
+        double t_view[kMaxWideChannels];
+        for (int c = 0; c < n; ++c) {
+            out->sky[c] = static_cast<float>(w.rayleigh_scattering[c] * sum_r[c] * pr +
+                                             w.mie_scattering[c] * sum_m[c] * pm);
+            t_view[c] = Exp(-tau_view[c]);
+            out->transmittance[c] = static_cast<float>(t_view[c]);
+        }
+        if (want_ground && seg.hits_ground) {
+            w.Ground(camera + dir * seg.t_end, sun, nullptr, t_view, out);
+        }
     }
 };
 
@@ -66,6 +152,18 @@ class RaymarchedModel : public SimpleEvaluatorModel<RaymarchedModel, RaymarchedE
     explicit RaymarchedModel(const RaymarchedOptions& options);
     static ModelInfo StaticInfo();
     void Prepare(const AtmosphereParameters& atmosphere) override;
+
+    // Wide channel batches (RaymarchedWideEvaluator).
+    void PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                     const BatchPrepare& prepare_batch = {}) override;
+    void RenderWide(const RenderRequest& request, std::vector<float>* values) const override;
+    std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
+
+  private:
+    bool wide_prepared_ = false;
+    RaymarchedWideEvaluator wide_;
+    AtmosphereParameters wide_atmosphere_;  // batch 0's (the common fields)
+    WideCoefficients wide_solar_;           // the batches' coefficients (solar irradiance)
 };
 
 }  // namespace atmos

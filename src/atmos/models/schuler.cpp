@@ -1,6 +1,8 @@
 #include "models/schuler.h"
 
+#include "atmos/error.h"
 #include "models/transmittance_chapman.h"
+#include "render/wide.h"
 
 namespace atmos {
 
@@ -13,6 +15,7 @@ ModelInfo SchulerModel::StaticInfo() {
     info.summary =
         "single scattering, view ray by the midpoint rule, light optical depth by the "
         "Chapman approximation; no ozone";
+    info.capabilities.wide_channels = true;
     info.options = OptionRows().Specs();
     info.thesis_name = "Schuler";
     info.thesis_lines = 106;
@@ -44,6 +47,38 @@ SchulerModel::SchulerModel(const SchulerOptions& options) {
 void SchulerModel::Prepare(const AtmosphereParameters& atmosphere) {
     SetAtmosphere(atmosphere);
     evaluator_.m = MakeAnalyticMedia(atmosphere);
+}
+
+void SchulerModel::PrepareWide(const std::vector<AtmosphereParameters>& batches,
+                               const BatchPrepare&) {
+    // No tables: each batch's Prepare() is its atmosphere and its
+    // AnalyticMedia, made here; the batches share all but the coefficients
+    // (MakeWideCoefficients checks).
+    const WideCoefficients coefficients = MakeWideCoefficients(batches);
+    for (const AtmosphereParameters& a : batches) WarnOutsideValidityDomain(Info(), a);
+    wide_ = SchulerWideEvaluator();
+    wide_.narrow = evaluator_;
+    wide_.narrow.atm = batches[0];
+    wide_.narrow.m = MakeAnalyticMedia(batches[0]);
+    wide_.w = coefficients;
+    for (size_t b = 0; b < batches.size(); ++b) {
+        const AnalyticMedia m = MakeAnalyticMedia(batches[b]);
+        for (int c = 0; c < 3; ++c) {
+            wide_.light_rayleigh[3 * b + static_cast<size_t>(c)] = m.rayleigh_scattering[c];
+            wide_.light_mie[3 * b + static_cast<size_t>(c)] = m.mie_extinction[c];
+        }
+    }
+    wide_prepared_ = true;
+}
+
+void SchulerModel::RenderWide(const RenderRequest& request, std::vector<float>* values) const {
+    if (!wide_prepared_) Fail("model schuler: PrepareWide() must run before RenderWide()");
+    RenderWideImage(wide_, MakeWidePixelSetup(request, wide_.narrow.atm, wide_.w), values);
+}
+
+std::vector<float> SchulerModel::SampleWide(const std::vector<SampleQuery>& queries) const {
+    if (!wide_prepared_) Fail("model schuler: PrepareWide() must run before SampleWide()");
+    return SampleAllWide(wide_, wide_.narrow.atm.bottom_radius, queries);
 }
 
 }  // namespace atmos
