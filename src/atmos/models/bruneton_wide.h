@@ -267,11 +267,7 @@ struct BrunetonWideEvaluator {
     ATMOS_HD void EvaluateWide(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun,
                                bool want_ground, WideRayResult* out) const {
         const int n = w.channels;
-        for (int c = 0; c < n; ++c) {
-            out->sky[c] = 0.0f;
-            out->ground[c] = 0.0f;
-            out->transmittance[c] = 1.0f;
-        }
+        out->Reset(n);
         const AtmosphereParameters& atm = lut.atm;
         const AtmosphereSegment seg =
             ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);

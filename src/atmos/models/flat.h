@@ -139,11 +139,7 @@ struct FlatWideMedia {
     // the atmosphere (the ground at the camera done).
     ATMOS_HD bool Begin(const Vec3d& camera, const Vec3d& dir, const Vec3d& sun, bool want_ground,
                         WideRayResult* out, AtmosphereSegment* seg) const {
-        for (int c = 0; c < channels; ++c) {
-            out->sky[c] = 0.0f;
-            out->ground[c] = 0.0f;
-            out->transmittance[c] = 1.0f;
-        }
+        out->Reset(channels);
         *seg = ClipToAtmosphere(camera, dir, optics.m.bottom, optics.m.top);
         out->hits_ground = seg->hits_ground;
         if (seg->inside) return true;

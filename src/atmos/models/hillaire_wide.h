@@ -278,11 +278,7 @@ struct HillaireWideEvaluator {
                                bool want_ground, WideRayResult* out) const {
         const AtmosphereParameters& atm = narrow.atm;
         const int n = w.channels;
-        for (int c = 0; c < n; ++c) {
-            out->sky[c] = 0.0f;
-            out->ground[c] = 0.0f;
-            out->transmittance[c] = 1.0f;
-        }
+        out->Reset(n);
         const AtmosphereSegment seg =
             ClipToAtmosphere(camera, dir, atm.bottom_radius, atm.top_radius);
         out->hits_ground = seg.hits_ground;

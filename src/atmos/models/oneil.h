@@ -382,11 +382,7 @@ struct OneilWideEvaluator {
                                bool want_ground, WideRayResult* out) const {
         const OneilOptics& o = narrow.optics;
         const int n = channels;
-        for (int c = 0; c < n; ++c) {
-            out->sky[c] = 0.0f;
-            out->ground[c] = 0.0f;
-            out->transmittance[c] = 1.0f;
-        }
+        out->Reset(n);
         const AtmosphereSegment seg = ClipToAtmosphere(camera, dir, o.m.bottom, o.m.top);
         out->hits_ground = seg.hits_ground;
         if (!seg.inside) {

@@ -59,6 +59,16 @@ struct WideRayResult {
     float ground[kMaxWideChannels];
     float transmittance[kMaxWideChannels];
     bool hits_ground = false;
+
+    // A ray that meets nothing yet: no sky, no ground, full transmittance in
+    // channels [0, n).
+    ATMOS_HD void Reset(int n) {
+        for (int c = 0; c < n; ++c) {
+            sky[c] = 0.0f;
+            ground[c] = 0.0f;
+            transmittance[c] = 1.0f;
+        }
+    }
 };
 
 // ---- lookups of a table of n channels (n <= kMaxWideChannels) ----
