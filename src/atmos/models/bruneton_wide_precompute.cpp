@@ -437,6 +437,12 @@ void WideIncident(const BrunetonWideEvaluator& ev, const WideIncidentInputs& in,
 // Eight float lanes (the GCC / Clang vector extension: each operation is the
 // scalar one per lane, IEEE, no contraction under -ffp-contract=off): the
 // lanes j of BrunetonPhaseSums.
+// Lanes never crosses this file (anonymous namespace), so GCC's note that a
+// 32-byte vector returned without AVX has another ABI (builds without
+// -march, e.g. CI's sanitizer build) does not apply.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
 typedef float Lanes __attribute__((vector_size(8 * sizeof(float))));
 static_assert(kBrunetonLanes == 8, "Lanes holds kBrunetonLanes floats");
 inline Lanes LoadLanes(const float* p) {
