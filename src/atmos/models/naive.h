@@ -307,16 +307,8 @@ struct NaiveWideEvaluator {
                 }
             }
         }
-        // FinishSingleScattering.
-        const double nu = Dot(dir, sun);
-        const double pr = RayleighPhase(nu), pm = MiePhase(atm, nu);
         double t_view[kMaxWideChannels];
-        for (int c = 0; c < n; ++c) {
-            out->sky[c] = static_cast<float>(w.rayleigh_scattering[c] * sum_r[c] * pr +
-                                             w.mie_scattering[c] * sum_m[c] * pm);
-            t_view[c] = Exp(-tau_view[c]);
-            out->transmittance[c] = static_cast<float>(t_view[c]);
-        }
+        FinishWideSingleScattering(atm, w, dir, sun, sum_r, sum_m, tau_view, t_view, out);
         if (want_ground && seg.hits_ground)
             Ground(prof, camera + dir * seg.t_end, sun, t_view, out);
     }

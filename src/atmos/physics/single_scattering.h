@@ -19,6 +19,7 @@
 #include "physics/geometry.h"
 #include "physics/phase.h"
 #include "physics/ray.h"
+#include "physics/wide.h"
 
 namespace atmos {
 
@@ -92,6 +93,25 @@ ATMOS_HD inline RayResult IntegrateSingleScattering(const AtmosphereParameters& 
     FinishSingleScattering(atm, medium, camera, dir, sun, seg, want_ground, sum_r, sum_m, tau_view,
                            &out);
     return out;
+}
+
+// FinishSingleScattering's sky and transmittance for the n = w.channels
+// channels of a wide evaluator (physics/wide.h): the phase functions once, then
+// per channel the same operations as the three-channel form. Writes the view
+// ray's transmittance per channel to t_view (for the ground term).
+ATMOS_HD inline void FinishWideSingleScattering(const AtmosphereParameters& atm,
+                                                const WideCoefficients& w, const Vec3d& dir,
+                                                const Vec3d& sun, const double* sum_r,
+                                                const double* sum_m, const double* tau_view,
+                                                double* t_view, WideRayResult* out) {
+    const double nu = Dot(dir, sun);
+    const double pr = RayleighPhase(nu), pm = MiePhase(atm, nu);
+    for (int c = 0; c < w.channels; ++c) {
+        out->sky[c] = static_cast<float>(w.rayleigh_scattering[c] * sum_r[c] * pr +
+                                         w.mie_scattering[c] * sum_m[c] * pm);
+        t_view[c] = Exp(-tau_view[c]);
+        out->transmittance[c] = static_cast<float>(t_view[c]);
+    }
 }
 
 }  // namespace atmos
