@@ -214,6 +214,17 @@ struct AplusWideTransmittanceStage {
 
 // AplusSingleScatteringStage (AplusSingleScattering) for every channel; one
 // column per item.
+// One column of an order's table (stage.Integrate's sums over its depth,
+// n Rayleigh channels then one Mie value per batch), written out.
+template <typename Stage>
+void IntegrateColumn(const Stage& stage, int64_t i) {
+    const int n = stage.w.channels, nb = n / 3, channels = n + nb;
+    const AplusWideColumn col = OpenColumn(i, stage.atm, stage.w, stage.s);
+    std::vector<double> sums(static_cast<size_t>(stage.s.depth) * channels, 0.0);
+    if (col.seg.inside) stage.Integrate(col, &sums);
+    WriteColumn(stage.w, col, stage.s, sums, stage.out);
+}
+
 struct AplusWideSingleScatteringStage {
     AtmosphereParameters atm;
     WideCoefficients w;
@@ -224,13 +235,7 @@ struct AplusWideSingleScatteringStage {
     void VisitTables(V& v) {
         v(out);
     }
-    void operator()(int64_t i) const {
-        const int n = w.channels, nb = n / 3, channels = n + nb;
-        const AplusWideColumn col = OpenColumn(i, atm, w, s);
-        std::vector<double> sums(static_cast<size_t>(s.depth) * channels, 0.0);
-        if (col.seg.inside) Integrate(col, &sums);
-        WriteColumn(w, col, s, sums, out);
-    }
+    void operator()(int64_t i) const { IntegrateColumn(*this, i); }
 
     void Integrate(const AplusWideColumn& col, std::vector<double>* sums_out) const {
         const int n = w.channels, nb = n / 3, channels = n + nb;
@@ -386,13 +391,7 @@ struct AplusWideOrderStage {
         v(gather);
         v(out);
     }
-    void operator()(int64_t i) const {
-        const int n = w.channels, nb = n / 3, channels = n + nb;
-        const AplusWideColumn col = OpenColumn(i, atm, w, s);
-        std::vector<double> sums(static_cast<size_t>(s.depth) * channels, 0.0);
-        if (col.seg.inside) Integrate(col, &sums);
-        WriteColumn(w, col, s, sums, out);
-    }
+    void operator()(int64_t i) const { IntegrateColumn(*this, i); }
 
     void Integrate(const AplusWideColumn& col, std::vector<double>* sums_out) const {
         const int n = w.channels, nb = n / 3, channels = n + nb;
