@@ -51,6 +51,9 @@
 // error per MiB, docs/models/atmosphere-plus.md), K = 5, 6 x 12 gather, n = 30.
 // Precomputation: the stage structs of atmosphere_plus_stages.h through
 // RunStage, on the CPU or (CUDA backend) on the device from the same code.
+// Wide channel batches (a spectral run's up to 16 batches of three in one
+// model): atmosphere_plus_wide.{h,cpp}, one column of a table per work item for
+// every channel, bit for bit the batches' tables and values.
 #pragma once
 
 #include <string>

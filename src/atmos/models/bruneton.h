@@ -38,7 +38,12 @@
 // once per (r, mu) row and shared by the row's (mu_s, nu) texels. Both are exact
 // rearrangements except for the rotated direction grid. Tables are per unit
 // solar irradiance. The horizon handling: see docs/models/bruneton.md ("bruneton:
-// horizon").
+// horizon"). Low sun over the ground (mu_s < 0.01): single Mie integrated along
+// the segment (`low-sun-mie=integrate`, 64 midpoint samples, the exponential in
+// float, within 2 ulp) in place of the seed's smoothstep fade (issue 15).
+// Spectral runs: one precomputation and one lookup per ray for every channel
+// of up to 16 batches (bruneton_wide.h, bruneton_wide_precompute.cpp), the
+// batches' tables and values bit for bit.
 #pragma once
 
 #include <functional>

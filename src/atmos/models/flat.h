@@ -31,6 +31,8 @@
 // Eq. 53 form (so the planet's shadow is a smooth, very large depth instead of
 // an explicit test); the shell is fitted to any absorption profile by its
 // column and centroid (physics/analytic_media.h).
+// Wide channel batches (up to 16 batches of three in one model):
+// FlatWideEvaluator below, bit for bit the batches' values.
 #pragma once
 
 #include <vector>

@@ -26,6 +26,9 @@
 // midpoint (Terrell adds the whole step first), the planet's shadow is tested
 // (Terrell has none), cameras in space start where the ray enters the
 // atmosphere, and everything runs in double.
+// Wide channel batches (up to 16 batches of three in one model):
+// NaiveWideEvaluator below, the geometry and light rays once per ray, bit for
+// bit the batches' values.
 #pragma once
 
 #include <vector>

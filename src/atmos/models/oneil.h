@@ -47,6 +47,9 @@
 // cosines too (the polynomial extrapolated past x = 1, which a refit does not
 // control) and switch shader by camera position; per-pixel evaluation here
 // (no vertex interpolation), in double.
+// Wide channel batches (up to 16 batches of three in one model):
+// OneilWideEvaluator below, the geometry once per ray, bit for bit the batches'
+// values; the exponentials of both forms run as ExpLane vector loops.
 #pragma once
 
 #include <vector>

@@ -21,6 +21,8 @@
 // Valid: any camera and sun where the flat optical depth is (looking up is its
 // best case); single scattering only. Deviations: those of `flat` (density at
 // the tangent point in Eq. 53, smooth planet shadow, fitted shell).
+// Wide channel batches (up to 16 batches of three in one model):
+// RaymarchedWideEvaluator below, bit for bit the batches' values.
 #pragma once
 
 #include <vector>

@@ -22,6 +22,8 @@
 // in Schuler's own unit, the 50% height H ln 2 (physics/analytic_optical_depth.h).
 // Valid: any camera and sun; error of the approximation: tests/analytic_test.cpp
 // (Chapman.*) and docs/models/schuler.md.
+// Wide channel batches (up to 16 batches of three in one model):
+// SchulerWideEvaluator below, bit for bit the batches' values.
 #pragma once
 
 #include <vector>
