@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "atmos/math.h"
+#include "base/table_storage.h"
 
 namespace atmos {
 
@@ -272,7 +273,7 @@ class Table {
         return next;
     }
     static uint64_t NewId() { return NextId().fetch_add(1); }
-    std::vector<float> data_;
+    std::vector<float, TableAllocator<float>> data_;
     TableView view_;
 };
 
