@@ -854,6 +854,75 @@ TEST(Bruneton, LowSunAerialPerspectiveHasNoDifferenceArtefact) {
     EXPECT_GT(worst_raw, 5.0 * worst);
 }
 
+TEST(Bruneton, LowSunSegmentSkipsOnlySamplesThatAddZero) {
+    // SegmentSingleMie skips the samples where the sun is below the horizon
+    // (their transmittance to the sun is 0, so they add exactly 0). Against
+    // the same midpoint sum over every sample (written out here, without the
+    // skip), bit for bit, on segments wholly lit, partly in the planet's
+    // shadow and wholly in it; the grid must hold each kind.
+    BrunetonConfig c = Small(1);
+    const Precomputed p(EarthAtmosphere(), c);
+    const BrunetonLut& lut = p.eval.lut;
+    const AtmosphereParameters& atm = lut.atm;
+    int lit = 0, partly = 0, dark = 0, compared = 0;
+    for (double h : {200.0, 5000.0, 15000.0}) {
+        for (double mu : {-0.02, -0.1, -0.3}) {
+            for (double mu_s : {0.009, 0.0, -0.01, -0.03, -0.06, -0.12}) {
+                for (double nu_sign : {-1.0, 1.0}) {
+                    const double r = atm.bottom_radius + h;
+                    const double disc =
+                        r * r * (mu * mu - 1.0) + atm.bottom_radius * atm.bottom_radius;
+                    if (disc < 0.0) continue;
+                    const double d = -r * mu - std::sqrt(disc);
+                    const double nu = nu_sign * 0.5;
+                    const int n = lut.cfg.low_sun_mie_steps;
+                    const double dt = d / n;
+                    double depth_r = 0.0, depth_m = 0.0, depth_o = 0.0;
+                    double sum[3] = {0.0, 0.0, 0.0};
+                    int shadowed = 0;
+                    for (int i = 0; i < n; ++i) {
+                        const double t = (i + 0.5) * dt;
+                        const double r_t =
+                            lut.ClampRadius(std::sqrt(t * t + 2.0 * r * mu * t + r * r));
+                        const Densities rho = GetDensities(atm, r_t - atm.bottom_radius);
+                        const double mid_r = depth_r + rho.rayleigh * (0.5 * dt);
+                        const double mid_m = depth_m + rho.mie * (0.5 * dt);
+                        const double mid_o = depth_o + rho.absorption * (0.5 * dt);
+                        depth_r += rho.rayleigh * dt;
+                        depth_m += rho.mie * dt;
+                        depth_o += rho.absorption * dt;
+                        const Rgb ts =
+                            lut.TransmittanceToSun(r_t, ClampCosine((r * mu_s + t * nu) / r_t));
+                        if (ts.x == 0.0f && ts.y == 0.0f && ts.z == 0.0f) ++shadowed;
+                        for (int ch = 0; ch < 3; ++ch) {
+                            const double tau = atm.rayleigh_scattering[ch] * mid_r +
+                                               atm.mie_extinction[ch] * mid_m +
+                                               atm.absorption_extinction[ch] * mid_o;
+                            const float e = ExpLaneF(static_cast<float>(-tau));
+                            sum[ch] += static_cast<double>(ts[ch]) * static_cast<double>(e) *
+                                       (rho.mie * dt);
+                        }
+                    }
+                    if (shadowed == 0) ++lit;
+                    if (shadowed > 0 && shadowed < n) ++partly;
+                    if (shadowed == n) ++dark;
+                    const Rgb got = lut.SegmentSingleMie(r, mu, mu_s, nu, d);
+                    for (int ch = 0; ch < 3; ++ch) {
+                        const float want = static_cast<float>(sum[ch] * atm.mie_scattering[ch]);
+                        EXPECT_EQ(got[ch], want) << h << " " << mu << " " << mu_s << " " << nu;
+                    }
+                    ++compared;
+                }
+            }
+        }
+    }
+    std::printf("low-sun segments: %d compared (%d lit, %d partly shadowed, %d dark)\n", compared,
+                lit, partly, dark);
+    EXPECT_GT(lit, 0);
+    EXPECT_GT(partly, 0);
+    EXPECT_GT(dark, 0);
+}
+
 TEST(Bruneton, HorizonArtefactIsMeasured) {
     // Radiance just above and just below the horizon from 5 km, single
     // scattering, table against the naive evaluator: reports the error of the

@@ -311,12 +311,18 @@ struct BrunetonLut {
     // GetTransmittanceToSun: the visible fraction of the sun's disc above the
     // horizon as a smoothstep (Bruneton's 2017 implementation notes, "Transmittance to the Sun").
     ATMOS_HD Rgb TransmittanceToSun(double r, double mu_s) const {
+        const double f = SunAboveHorizon(r, mu_s);
+        if (f <= 0.0) return Rgb(0.0f);
+        return TransmittanceToTop(r, mu_s) * static_cast<float>(f);
+    }
+    // GetTransmittanceToSun's visible fraction of the sun's disc above the
+    // horizon at (r, mu_s): 0 when the sun is below it, where the
+    // transmittance to the sun is 0.
+    ATMOS_HD double SunAboveHorizon(double r, double mu_s) const {
         const double sin_theta_h = atm.bottom_radius / r;
         const double cos_theta_h = -SafeSqrt(1.0 - sin_theta_h * sin_theta_h);
         const double a = sin_theta_h * atm.sun_angular_radius;
-        const double f = SmoothStep(-a, a, mu_s - cos_theta_h);
-        if (f <= 0.0) return Rgb(0.0f);
-        return TransmittanceToTop(r, mu_s) * static_cast<float>(f);
+        return SmoothStep(-a, a, mu_s - cos_theta_h);
     }
 
     // ---- scattering table mapping (Bruneton's 2017 implementation notes, "Precomputation" of
@@ -700,7 +706,8 @@ struct BrunetonLut {
     // channel's from them), the sun's from the table (GetTransmittanceToSun,
     // as in the precomputed single scattering). The exponential is ExpLaneF
     // (physics/vector_exp.h, float, within 2 ulp), which the wide evaluator
-    // runs as one vector loop over its channels.
+    // runs as one vector loop over its channels. Samples where the sun is
+    // below the horizon add nothing and are skipped.
     ATMOS_HD Rgb SegmentSingleMie(double r, double mu, double mu_s, double nu, double d) const {
         const int n = cfg.low_sun_mie_steps;
         const double dt = d / n;
@@ -716,7 +723,12 @@ struct BrunetonLut {
             depth_r += rho.rayleigh * dt;
             depth_m += rho.mie * dt;
             depth_o += rho.absorption * dt;
-            const Rgb ts = TransmittanceToSun(r_t, ClampCosine((r * mu_s + t * nu) / r_t));
+            // A sample in the planet's shadow adds exactly 0 (a zero
+            // transmittance to the sun times finite factors): skipped.
+            const double mu_s_t = ClampCosine((r * mu_s + t * nu) / r_t);
+            const double f = SunAboveHorizon(r_t, mu_s_t);
+            if (f <= 0.0) continue;
+            const Rgb ts = TransmittanceToTop(r_t, mu_s_t) * static_cast<float>(f);
             const double m = rho.mie * dt;
             for (int c = 0; c < 3; ++c) {
                 const double tau = atm.rayleigh_scattering[c] * mid_r +

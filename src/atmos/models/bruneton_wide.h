@@ -94,10 +94,10 @@ struct BrunetonWideEvaluator {
     }
     // TransmittanceToSun.
     ATMOS_HD void TransmittanceToSun(double r, double mu_s, float* out) const {
-        const double sin_theta_h = lut.atm.bottom_radius / r;
-        const double cos_theta_h = -SafeSqrt(1.0 - sin_theta_h * sin_theta_h);
-        const double a = sin_theta_h * lut.atm.sun_angular_radius;
-        const double f = BrunetonLut::SmoothStep(-a, a, mu_s - cos_theta_h);
+        TransmittanceToSunWith(lut.SunAboveHorizon(r, mu_s), r, mu_s, out);
+    }
+    // TransmittanceToSun with f = lut.SunAboveHorizon(r, mu_s).
+    ATMOS_HD void TransmittanceToSunWith(double f, double r, double mu_s, float* out) const {
         const int n = w.channels;
         if (f <= 0.0) {
             for (int c = 0; c < n; ++c) out[c] = 0.0f;
@@ -181,7 +181,11 @@ struct BrunetonWideEvaluator {
             depth_r += rho.rayleigh * dt;
             depth_m += rho.mie * dt;
             depth_o += rho.absorption * dt;
-            TransmittanceToSun(r_t, ClampCosine((r * mu_s + t * nu) / r_t), ts);
+            // In the planet's shadow: adds exactly 0, skipped (as BrunetonLut).
+            const double mu_s_t = ClampCosine((r * mu_s + t * nu) / r_t);
+            const double f = lut.SunAboveHorizon(r_t, mu_s_t);
+            if (f <= 0.0) continue;
+            TransmittanceToSunWith(f, r_t, mu_s_t, ts);
             const double m = rho.mie * dt;
             ATMOS_SIMD_WIDE
             for (int c = 0; c < n; ++c) {
