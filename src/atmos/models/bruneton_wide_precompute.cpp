@@ -15,6 +15,7 @@
 // (tests/bruneton_wide_precompute_test.cpp). CPU only: the device backend
 // keeps the per-batch precomputation (BrunetonModel::PrepareWide).
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <vector>
 
@@ -361,15 +362,28 @@ struct WideIncidentInputs {
     const float* solid_angle = nullptr;
     int order = 2;
 };
+// Where channel c's direction k lies in a (r, mu_s) pair's n x 512 incident
+// floats: channels in pairs (c, c + 1), each pair's directions in blocks of
+// kBrunetonLanes, a block holding the pair's two channels' lanes one after
+// the other, so that one 16-float load holds both channels' lanes of a block
+// (the density's sums, DensitySums).
+inline size_t IncidentIndex(int c, int k) {
+    constexpr int blocks = kBrunetonDirections / kBrunetonLanes;
+    return ((static_cast<size_t>(c / 2) * blocks + static_cast<size_t>(k / kBrunetonLanes)) * 2 +
+            static_cast<size_t>(c % 2)) *
+               kBrunetonLanes +
+           static_cast<size_t>(k % kBrunetonLanes);
+}
+
 void WideIncident(const BrunetonWideEvaluator& ev, const WideIncidentInputs& in, Table* incident) {
     const BrunetonLut& lut = ev.lut;
     const WideCoefficients& w = ev.w;
     const AtmosphereParameters& atm = lut.atm;
     const BrunetonConfig& cfg = lut.cfg;
     const int n = w.channels;
-    const size_t nn = static_cast<size_t>(n);
-    const size_t kd = static_cast<size_t>(kBrunetonDirections);
-    incident->Resize(n * kBrunetonDirections, cfg.scattering_mu_s, cfg.scattering_r, 1);
+    // Channel pairs' blocks (IncidentIndex), an odd channel count's last pair
+    // half empty.
+    incident->Resize((n + (n & 1)) * kBrunetonDirections, cfg.scattering_mu_s, cfg.scattering_r, 1);
     bool any_albedo = false;
     for (int b = 0; b < n / 3; ++b) any_albedo = any_albedo || w.BatchMaxAlbedo(b) > 0.0;
     RunWide("bruneton wide incident radiance",
@@ -428,27 +442,128 @@ void WideIncident(const BrunetonWideEvaluator& ev, const WideIncidentInputs& in,
                         }
                     }
                     const float wk = in.solid_angle[k];
-                    const size_t kk = static_cast<size_t>(k);
-                    for (size_t c = 0; c < nn; ++c) out[c * kd + kk] = inc[c] * wk;
+                    for (int c = 0; c < n; ++c) out[IncidentIndex(c, k)] = inc[c] * wk;
                 }
             });
 }
 
-// Eight float lanes (the GCC / Clang vector extension: each operation is the
-// scalar one per lane, IEEE, no contraction under -ffp-contract=off): the
-// lanes j of BrunetonPhaseSums.
-// Lanes never crosses this file (anonymous namespace), so GCC's note that a
-// 32-byte vector returned without AVX has another ABI (builds without
-// -march, e.g. CI's sanitizer build) does not apply.
+// Sixteen float lanes (the GCC / Clang vector extension: each operation is the
+// scalar one per lane, IEEE, no contraction under -ffp-contract=off): lanes
+// 0-7 and 8-15 are BrunetonPhaseSums' lanes j of a pair of channels.
+// Lanes16 never crosses this file (anonymous namespace), so GCC's note that a
+// 64-byte vector returned without AVX-512 has another ABI (builds without it)
+// does not apply.
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
-typedef float Lanes __attribute__((vector_size(8 * sizeof(float))));
-static_assert(kBrunetonLanes == 8, "Lanes holds kBrunetonLanes floats");
-inline Lanes LoadLanes(const float* p) {
-    Lanes v;
+typedef float Lanes16 __attribute__((vector_size(2 * kBrunetonLanes * sizeof(float))));
+static_assert(kBrunetonLanes == 8, "a pair's block is 2 x 8 floats");
+constexpr int kPhaseBlocks = kBrunetonDirections / kBrunetonLanes;
+constexpr size_t kPairFloats = 2 * static_cast<size_t>(kBrunetonDirections);
+
+inline Lanes16 Load16(const float* p) {
+    Lanes16 v;
     std::memcpy(&v, p, sizeof(v));
     return v;
+}
+inline void Store16(float* p, const Lanes16& v) { std::memcpy(p, &v, sizeof(v)); }
+
+// BrunetonPhaseSums' lane sums of every channel: ar[8c + j] (and, with kTwo,
+// am[8c + j]) = the sum over the directions k = j, j + 8, ... in order of
+// p[k] x l_c[k] (q[k] x l_c[k]), in float from 0, where l is a pair's incident
+// radiance in IncidentIndex's layout and p2 (q2) holds each block of eight
+// directions' phase values twice (16 floats). kPairs channel pairs at a time,
+// with independent accumulators.
+template <bool kTwo, int kPairs>
+__attribute__((always_inline)) inline void PhaseSumsBody(const float* __restrict__ l, int pairs,
+                                                         const float* __restrict__ p2,
+                                                         const float* __restrict__ q2,
+                                                         float* __restrict__ ar,
+                                                         float* __restrict__ am) {
+    int pp = 0;
+    for (; pp + kPairs <= pairs; pp += kPairs) {
+        const float* b[kPairs];
+        Lanes16 r[kPairs], m[kPairs];
+        for (int i = 0; i < kPairs; ++i) {
+            b[i] = l + static_cast<size_t>(pp + i) * kPairFloats;
+            r[i] = Lanes16{};
+            m[i] = Lanes16{};
+        }
+        for (int kb = 0; kb < kPhaseBlocks; ++kb) {
+            const size_t o = static_cast<size_t>(kb) * 2 * kBrunetonLanes;
+            const Lanes16 p = Load16(p2 + o);
+            if (kTwo) {
+                const Lanes16 q = Load16(q2 + o);
+                for (int i = 0; i < kPairs; ++i) {
+                    const Lanes16 a = Load16(b[i] + o);
+                    r[i] += p * a;
+                    m[i] += q * a;
+                }
+            } else {
+                for (int i = 0; i < kPairs; ++i) r[i] += p * Load16(b[i] + o);
+            }
+        }
+        for (int i = 0; i < kPairs; ++i) {
+            Store16(ar + static_cast<size_t>(pp + i) * 2 * kBrunetonLanes, r[i]);
+            if (kTwo) Store16(am + static_cast<size_t>(pp + i) * 2 * kBrunetonLanes, m[i]);
+        }
+    }
+    for (; pp < pairs; ++pp) {
+        const float* b0 = l + static_cast<size_t>(pp) * kPairFloats;
+        Lanes16 r0 = {}, m0 = {};
+        for (int kb = 0; kb < kPhaseBlocks; ++kb) {
+            const size_t o = static_cast<size_t>(kb) * 2 * kBrunetonLanes;
+            const Lanes16 a = Load16(b0 + o);
+            r0 += Load16(p2 + o) * a;
+            if (kTwo) m0 += Load16(q2 + o) * a;
+        }
+        Store16(ar + static_cast<size_t>(pp) * 2 * kBrunetonLanes, r0);
+        if (kTwo) Store16(am + static_cast<size_t>(pp) * 2 * kBrunetonLanes, m0);
+    }
+}
+
+// PhaseSumsBody for this machine: with AVX-512 (32 registers of 16 floats)
+// four pairs at a time, else two (a Lanes16 is then two 8-float registers).
+// The same operations per lane either way, so the same bits.
+template <bool kTwo>
+void PhaseSumsPortable(const float* l, int pairs, const float* p2, const float* q2, float* ar,
+                       float* am) {
+    PhaseSumsBody<kTwo, 2>(l, pairs, p2, q2, ar, am);
+}
+#if defined(__x86_64__) && defined(__GNUC__)
+template <bool kTwo>
+__attribute__((target("avx512f"))) void PhaseSumsAvx512(const float* l, int pairs, const float* p2,
+                                                        const float* q2, float* ar, float* am) {
+    PhaseSumsBody<kTwo, 4>(l, pairs, p2, q2, ar, am);
+}
+bool UseAvx512() {
+    static const bool use = [] {
+        const char* v = std::getenv("ATMOS_WIDE_AVX512");
+        if (v && std::strcmp(v, "0") == 0) return false;
+        return __builtin_cpu_supports("avx512f") != 0;
+    }();
+    return use;
+}
+#endif
+template <bool kTwo>
+void PhaseSums(const float* l, int pairs, const float* p2, const float* q2, float* ar, float* am) {
+#if defined(__x86_64__) && defined(__GNUC__)
+    if (UseAvx512()) {
+        PhaseSumsAvx512<kTwo>(l, pairs, p2, q2, ar, am);
+        return;
+    }
+#endif
+    PhaseSumsPortable<kTwo>(l, pairs, p2, q2, ar, am);
+}
+
+// Each block of eight values of v (kBrunetonDirections) twice: 16 floats.
+inline void DoubleBlocks(const float* v, float* v2) {
+    for (int kb = 0; kb < kPhaseBlocks; ++kb) {
+        std::memcpy(v2 + 2 * kBrunetonLanes * kb, v + kBrunetonLanes * kb,
+                    kBrunetonLanes * sizeof(float));
+        std::memcpy(v2 + 2 * kBrunetonLanes * kb + kBrunetonLanes, v + kBrunetonLanes * kb,
+                    kBrunetonLanes * sizeof(float));
+    }
 }
 
 // ---- scattering density J_n (BrunetonDensityStage): per texel the phase
@@ -461,6 +576,7 @@ void WideDensity(const BrunetonWideEvaluator& ev, const TableView& incident,
     const AtmosphereParameters& atm = lut.atm;
     const BrunetonConfig& cfg = lut.cfg;
     const int n = w.channels;
+    const int pairs = (n + 1) / 2;
     const int width = cfg.scattering_nu * cfg.scattering_mu_s;
     density->Resize(width, cfg.scattering_mu, cfg.scattering_r, n);
     const BrunetonDirections grid(directions);
@@ -475,7 +591,13 @@ void WideDensity(const BrunetonWideEvaluator& ev, const TableView& incident,
         static_cast<int64_t>(cfg.scattering_mu_s) * cfg.scattering_r, 1, [&](int64_t pair) {
             const int s_pair = static_cast<int>(pair % cfg.scattering_mu_s);
             const int z = static_cast<int>(pair / cfg.scattering_mu_s);
-            alignas(32) float pr[kd], pm[kd], pm2[kd];
+            alignas(64) float pr[kd], pm[kd], pm2[kd];
+            alignas(64) float pr2[2 * kd], pm2x[2 * kd], pm22[2 * kd];
+            // The lane sums of each channel (8 floats per channel, pairs' halves).
+            std::vector<float> sums(static_cast<size_t>(3 * pairs) * 2 * lanes);
+            float* const ar = sums.data();
+            float* const am = ar + static_cast<size_t>(pairs) * 2 * lanes;
+            float* const am2 = am + static_cast<size_t>(pairs) * 2 * lanes;
             std::vector<double> prd, pmd;
             if (!cornette_shanks) {
                 prd.resize(kd);
@@ -509,17 +631,16 @@ void WideDensity(const BrunetonWideEvaluator& ev, const TableView& incident,
                     const double rho_r = GetProfileDensity(atm.rayleigh_density, alt);
                     const double rho_m = GetProfileDensity(atm.mie_density, alt);
                     for (int c = 0; c < n; ++c) {
-                        const float* lc = l + static_cast<size_t>(c) * kd;
-                        double ar = 0.0, am = 0.0;
+                        double ar_d = 0.0, am_d = 0.0;
                         for (int k = 0; k < kd; ++k) {
-                            const double v = static_cast<double>(lc[k]);
-                            ar += prd[k] * v;
-                            am += pmd[k] * v;
+                            const double v = static_cast<double>(l[IncidentIndex(c, k)]);
+                            ar_d += prd[k] * v;
+                            am_d += pmd[k] * v;
                         }
                         const float br = static_cast<float>(w.rayleigh_scattering[c] *
                                                             (rho_r * (3.0 / (16.0 * kPi))));
                         const float bm = static_cast<float>(w.mie_scattering[c] * rho_m);
-                        o[c] = static_cast<float>(ar) * br + static_cast<float>(am) * bm;
+                        o[c] = static_cast<float>(ar_d) * br + static_cast<float>(am_d) * bm;
                     }
                     continue;
                 }
@@ -536,6 +657,9 @@ void WideDensity(const BrunetonWideEvaluator& ev, const TableView& incident,
                     pr[k] = p;
                     pm[k] = p / (den * Sqrt(den));
                 }
+                DoubleBlocks(pr, pr2);
+                DoubleBlocks(pm, pm2x);
+                PhaseSums<true>(l, pairs, pr2, pm2x, ar, am);
                 if (w2 != 0.0) {  // the second lobe's (BrunetonPhaseSums with g2)
                     ATMOS_SIMD_WIDE
                     for (int k = 0; k < kd; ++k) {
@@ -544,76 +668,35 @@ void WideDensity(const BrunetonWideEvaluator& ev, const TableView& incident,
                         const float den2 = g2p - g2m * xk;
                         pm2[k] = p / (den2 * Sqrt(den2));
                     }
+                    DoubleBlocks(pm2, pm22);
+                    PhaseSums<false>(l, pairs, pm22, nullptr, am2, nullptr);
                 }
                 const double k_r = 3.0 / (16.0 * kPi);
                 const double k_m = 3.0 / (8.0 * kPi) * (1.0 - g * g) / (2.0 + g * g);
                 const double rho_r = GetProfileDensity(atm.rayleigh_density, alt);
                 const double rho_m = GetProfileDensity(atm.mie_density, alt);
                 const double k_m2 = 3.0 / (8.0 * kPi) * (1.0 - g2d * g2d) / (2.0 + g2d * g2d);
-                // The channels' sums, four channels at a time (eight
-                // independent accumulators; each channel's lanes as
-                // BrunetonPhaseSums' ar[ch][j] / am[ch][j]).
-                const auto finish = [&](int c, const Lanes& ar, const Lanes& am) {
-                    double sa = 0.0, sb = 0.0;
-                    for (int j = 0; j < lanes; ++j) {
-                        sa += static_cast<double>(ar[j]);
-                        sb += static_cast<double>(am[j]);
-                    }
-                    const float sum_r = static_cast<float>(sa), sum_m = static_cast<float>(sb);
+                // Each channel's lanes summed in double in lane order (as
+                // BrunetonPhaseSums).
+                const auto lane_sum = [&](const float* v, int c) {
+                    const float* vc = v + static_cast<size_t>(c) * lanes;
+                    double sum = 0.0;
+                    for (int j = 0; j < lanes; ++j) sum += static_cast<double>(vc[j]);
+                    return static_cast<float>(sum);
+                };
+                for (int c = 0; c < n; ++c) {
+                    const float sum_r = lane_sum(ar, c), sum_m = lane_sum(am, c);
                     const float br = static_cast<float>(w.rayleigh_scattering[c] * (rho_r * k_r));
                     if (w2 == 0.0) {
                         const float bm = static_cast<float>(w.mie_scattering[c] * (rho_m * k_m));
                         o[c] = sum_r * br + sum_m * bm;
-                        return;
+                        continue;
                     }
-                    // The second lobe's sums (BrunetonPhaseSums with g2).
-                    const float* lc = l + static_cast<size_t>(c) * kd;
-                    Lanes am2 = {};
-                    for (int k0 = 0; k0 < kd; k0 += lanes) {
-                        am2 += LoadLanes(pm2 + k0) * LoadLanes(lc + k0);
-                    }
-                    double sc = 0.0;
-                    for (int j = 0; j < lanes; ++j) sc += static_cast<double>(am2[j]);
-                    const float sum_m2 = static_cast<float>(sc);
+                    const float sum_m2 = lane_sum(am2, c);
                     const float bm =
                         static_cast<float>(w.mie_scattering[c] * (rho_m * (1.0 - w2) * k_m));
                     const float bm2 = static_cast<float>(w.mie_scattering[c] * (rho_m * w2 * k_m2));
                     o[c] = sum_r * br + sum_m * bm + sum_m2 * bm2;
-                };
-                int c = 0;
-                for (; c + 4 <= n; c += 4) {
-                    const float* l0 = l + static_cast<size_t>(c) * kd;
-                    const float* l1 = l0 + kd;
-                    const float* l2 = l1 + kd;
-                    const float* l3 = l2 + kd;
-                    Lanes r0 = {}, r1 = {}, r2 = {}, r3 = {}, m0 = {}, m1 = {}, m2 = {}, m3 = {};
-                    for (int k0 = 0; k0 < kd; k0 += lanes) {
-                        const Lanes p = LoadLanes(pr + k0), q = LoadLanes(pm + k0);
-                        const Lanes a0 = LoadLanes(l0 + k0), a1 = LoadLanes(l1 + k0);
-                        const Lanes a2 = LoadLanes(l2 + k0), a3 = LoadLanes(l3 + k0);
-                        r0 += p * a0;
-                        m0 += q * a0;
-                        r1 += p * a1;
-                        m1 += q * a1;
-                        r2 += p * a2;
-                        m2 += q * a2;
-                        r3 += p * a3;
-                        m3 += q * a3;
-                    }
-                    finish(c, r0, m0);
-                    finish(c + 1, r1, m1);
-                    finish(c + 2, r2, m2);
-                    finish(c + 3, r3, m3);
-                }
-                for (; c < n; ++c) {
-                    const float* lc = l + static_cast<size_t>(c) * kd;
-                    Lanes ar = {}, am = {};
-                    for (int k0 = 0; k0 < kd; k0 += lanes) {
-                        const Lanes a = LoadLanes(lc + k0);
-                        ar += LoadLanes(pr + k0) * a;
-                        am += LoadLanes(pm + k0) * a;
-                    }
-                    finish(c, ar, am);
                 }
             }
         });
