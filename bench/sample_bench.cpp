@@ -6,7 +6,7 @@
 // Queries (i in [0, 10^6)): altitude 0, mu = -1 + 2 (i % 1000) / 999,
 // mu_s = -0.2 + 1.2 (i / 1000) / 999, azimuth 0.
 //
-// BM_ModelSampleRandomBruneton{Rgb,Wide40}: one thread, 20 000 queries drawn as
+// BM_ModelSampleRandom{Bruneton,Oneil}{Rgb,Wide40}: one thread, 20 000 queries drawn as
 // bench/query_cost.py draws them (altitude 0-20 km, mu in [-0.3, 1], mu_s in
 // [-0.2, 1], any azimuth), RGB or 40 wavelengths in wide channel batches
 // (PrepareWide); counters ns_per_query and ns_per_wavelength (3 for RGB; issue 37's
@@ -121,6 +121,16 @@ void BM_ModelSampleRandomBrunetonWide40(benchmark::State& state) {
     RunRandomSample(state, "bruneton:orders=1", true);
 }
 BENCHMARK(BM_ModelSampleRandomBrunetonWide40)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_ModelSampleRandomOneilRgb(benchmark::State& state) {
+    RunRandomSample(state, "oneil", false);
+}
+BENCHMARK(BM_ModelSampleRandomOneilRgb)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_ModelSampleRandomOneilWide40(benchmark::State& state) {
+    RunRandomSample(state, "oneil", true);
+}
+BENCHMARK(BM_ModelSampleRandomOneilWide40)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace atmos
