@@ -11,6 +11,7 @@
 
 #include "atmos/atmosphere.h"
 #include "atmos/image.h"
+#include "atmos/spectral.h"
 #include "atmos/view.h"
 #include "models/hillaire.h"
 #include "models/hillaire_stages.h"
@@ -73,6 +74,32 @@ TEST(HillaireStages, PrepareRenderAndSampleRunTheirTablesAsStages) {
                                               {200e3, 0.5, 0.2, 60.0}};
     (void)model.Sample(queries);
     EXPECT_EQ(Names(log), (std::vector<std::string>{"sample"}));
+}
+
+// The wide channel batches' stages (CPU only) are in the stage log too:
+// PrepareWide's two tables, a frame's sky-view and aerial-perspective tables.
+TEST(HillaireStages, WideStagesAreLogged) {
+    const SpectralAtmosphere spectral = LoadSpectralAtmosphere("earth");
+    const std::vector<AtmosphereParameters> batches = {spectral.AtWavelengths(680, 550, 440),
+                                                       spectral.AtWavelengths(620, 500, 410)};
+    HillaireModel model = MakeModel();
+    std::vector<StageTime> log;
+    const StageLogScope scope(&log);
+    model.PrepareWide(batches);
+    ASSERT_EQ(Names(log), (std::vector<std::string>{"hillaire/wide-transmittance",
+                                                    "hillaire/wide-multiple-scattering"}));
+    EXPECT_EQ(log[0].items, kHillaireTransmittanceWidth * kHillaireTransmittanceHeight);
+    EXPECT_EQ(log[1].items, kHillaireMsSize * kHillaireMsSize);
+    for (const StageTime& t : log) EXPECT_EQ(t.backend, "cpu");
+    log.clear();
+    const RenderRequest request =
+        atmos_test::QuietRequest(GetView("ground-sunrise", batches[0]), 16, 9);
+    std::vector<float> values;
+    model.RenderWide(request, &values);
+    ASSERT_EQ(Names(log), (std::vector<std::string>{"hillaire/wide-sky-view",
+                                                    "hillaire/wide-aerial-perspective"}));
+    EXPECT_EQ(log[0].items, kHillaireSkyViewWidth * kHillaireSkyViewHeight);
+    EXPECT_EQ(log[1].items, kHillaireApSize * kHillaireApSize);
 }
 
 // The stages write only their own texels, so the tables do not depend on the

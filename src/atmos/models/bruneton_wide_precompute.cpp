@@ -40,12 +40,7 @@ constexpr int kWideBatches = kMaxWideChannels / 3;
 // Runs body(i) for i < count (ParallelFor) and logs it as a CPU stage.
 template <typename F>
 void RunWide(const char* name, int64_t count, int64_t grain, const F& body) {
-    const Clock::time_point start = Clock::now();
-    ParallelFor(count, grain, body);
-    if (CurrentStageLog()) {
-        const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-        LogStage({name, count, "cpu", ms, ms});
-    }
+    RunCpuStage(name, count, grain, body);
 }
 
 size_t Texels(const Table& t) { return static_cast<size_t>(t.width()) * t.height() * t.depth(); }

@@ -280,7 +280,8 @@ void HillaireModel::PrepareWide(const std::vector<AtmosphereParameters>& batches
     t.w = w;
     t.steps = transmittance_steps_;
     t.out = transmittance.data();
-    ParallelFor(int64_t{kHillaireTransmittanceWidth} * kHillaireTransmittanceHeight, 64,
+    RunCpuStage("hillaire/wide-transmittance",
+                int64_t{kHillaireTransmittanceWidth} * kHillaireTransmittanceHeight, 64,
                 [&t](int64_t i) { t(i); });
     e.narrow.transmittance = transmittance.view();
     Table multiple_scattering(kHillaireMsSize, kHillaireMsSize, 1, n);
@@ -291,7 +292,8 @@ void HillaireModel::PrepareWide(const std::vector<AtmosphereParameters>& batches
     ms.e.narrow.multiple_scattering = TableView{};  // not read (the table being built)
     ms.out = multiple_scattering.data();
     ms.transfer = transfer.data();
-    ParallelFor(int64_t{kHillaireMsSize} * kHillaireMsSize, 4, [&ms](int64_t i) { ms(i); });
+    RunCpuStage("hillaire/wide-multiple-scattering", int64_t{kHillaireMsSize} * kHillaireMsSize, 4,
+                [&ms](int64_t i) { ms(i); });
     wide_atm_ = batches[0];
     wide_ = w;
     wide_transmittance_ = std::move(transmittance);
@@ -342,7 +344,8 @@ void HillaireModel::RenderWide(const RenderRequest& request, std::vector<float>*
         sv.sun = Vec3d(SafeSqrt(1.0 - mu_s * mu_s), 0.0, mu_s);
         sv.steps = sky_view_steps_;
         sv.out = sky_view.data();
-        ParallelFor(int64_t{kHillaireSkyViewWidth} * kHillaireSkyViewHeight, 32,
+        RunCpuStage("hillaire/wide-sky-view",
+                    int64_t{kHillaireSkyViewWidth} * kHillaireSkyViewHeight, 32,
                     [&sv](int64_t i) { sv(i); });
         e.narrow.sky_view = sky_view.view();
         // The volume is a perspective frustum (Render).
@@ -359,7 +362,8 @@ void HillaireModel::RenderWide(const RenderRequest& request, std::vector<float>*
             ap.steps_per_slice = ap_steps_per_slice_;
             ap.scatter = ap_scatter.data();
             ap.transmittance = ap_transmittance.data();
-            ParallelFor(int64_t{kHillaireApSize} * kHillaireApSize, 4, [&ap](int64_t i) { ap(i); });
+            RunCpuStage("hillaire/wide-aerial-perspective",
+                        int64_t{kHillaireApSize} * kHillaireApSize, 4, [&ap](int64_t i) { ap(i); });
             e.narrow.ap_camera = camera_frame;
             e.narrow.ap_aspect = aspect;
             e.narrow.ap_scatter = ap_scatter.view();

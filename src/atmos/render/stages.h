@@ -377,6 +377,21 @@ void ParallelForWithProgress(int64_t count, int64_t grain, Progress* progress, c
 
 // Runs stage(i) for i in [0, count) on the current backend (see the top of
 // this file); `progress` (may be null) is advanced by one per item.
+// Runs body(i) for i < count on the CPU (ParallelFor), whatever the backend,
+// and logs it as a CPU stage: the stages of the wide channel batches, which
+// have no device form.
+template <typename Body>
+void RunCpuStage(const char* name, int64_t count, int64_t grain, const Body& body) {
+    const auto start = std::chrono::steady_clock::now();
+    ParallelFor(count, grain, body);
+    if (CurrentStageLog()) {
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        LogStage({name, count, "cpu", ms, ms});
+    }
+}
+
 template <typename Stage>
 void RunStage(const char* name, int64_t count, int64_t grain, const Stage& stage,
               Progress* progress = nullptr) {
