@@ -3,12 +3,18 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <utility>
 #include <vector>
 
 #include "atmos/atmosphere.h"
+#include "base/cpu_features.h"
+#include "models/lane_loops.h"
+#include "models/oneil.h"
 #include "physics/density.h"
 #include "physics/vector_exp.h"
 
@@ -114,6 +120,64 @@ TEST(VectorExp, LaneProfileIsGetProfileDensity) {
     EXPECT_FALSE(LaneProfile(earth.absorption_density).any_exp);
     EXPECT_TRUE(LaneProfile(earth.rayleigh_density).any_exp);
 }
+
+#if ATMOS_HOST_AVX512_DISPATCH
+// The lane loops' AVX-512 forms (models/lane_loops.h: 8-double vectors) give
+// the default forms' bits on every value: exponents over the whole range and
+// its edges (including the clamps, 0 and infinity), n from 1 to 48 (the
+// vector loops' remainders).
+TEST(LaneLoops, Avx512FormsEqualTheDefaultFormsBitForBit) {
+    if (!__builtin_cpu_supports("avx512f")) GTEST_SKIP() << "no AVX-512 on this CPU";
+    std::mt19937_64 rng(37);
+    std::uniform_real_distribution<double> wide(-760.0, 720.0), small(-3.0, 3.0), coeff(0.0, 5e-5),
+        length(0.0, 2e6), weight(0.0, 1e3);
+    const double edges[] = {-800.0, -746.0, -745.1, -700.0, -1e-300, 0.0,
+                            1e-300, 60.0,   709.7,  710.0,  800.0};
+    const auto same = [](double a, double b) {
+        uint64_t x, y;
+        std::memcpy(&x, &a, sizeof x);
+        std::memcpy(&y, &b, sizeof y);
+        return x == y;
+    };
+    int compared = 0;
+    for (int round = 0; round < 200; ++round) {
+        const int n = 1 + round % 48;
+        std::vector<double> x(static_cast<size_t>(n));
+        for (int i = 0; i < n; ++i) {
+            const double v = round % 3 == 0 ? wide(rng) : small(rng);
+            x[static_cast<size_t>(i)] = round % 7 == 0 ? edges[(i + round) % 11] : v;
+        }
+        std::vector<double> a = x, b = x;
+        ExpNegLanesDefault(a.data(), n);
+        ExpNegLanesAvx512(b.data(), n);
+        for (int i = 0; i < n; ++i) ASSERT_TRUE(same(a[i], b[i])) << "ExpNegLanes " << x[i];
+        a = x;
+        b = x;
+        OneilSafeExpLanesDefault(a.data(), n);
+        OneilSafeExpLanesAvx512(b.data(), n);
+        for (int i = 0; i < n; ++i) ASSERT_TRUE(same(a[i], b[i])) << "OneilSafeExpLanes " << x[i];
+        std::vector<double> ca(static_cast<size_t>(n)), cb(static_cast<size_t>(n));
+        for (int i = 0; i < n; ++i) {
+            ca[static_cast<size_t>(i)] = coeff(rng);
+            cb[static_cast<size_t>(i)] = coeff(rng);
+        }
+        const double l_r = length(rng), l_m = length(rng) * 0.1, w_r = weight(rng),
+                     w_m = weight(rng);
+        std::vector<double> ra(x), ma(x), rb(x), mb(x);
+        for (int step = 0; step < 3; ++step) {
+            OneilAttenuateLanesDefault(ca.data(), cb.data(), n, l_r * step, l_m * step, w_r, w_m,
+                                       ra.data(), ma.data());
+            OneilAttenuateLanesAvx512(ca.data(), cb.data(), n, l_r * step, l_m * step, w_r, w_m,
+                                      rb.data(), mb.data());
+        }
+        for (int i = 0; i < n; ++i) {
+            ASSERT_TRUE(same(ra[i], rb[i]) && same(ma[i], mb[i])) << "OneilAttenuateLanes " << i;
+        }
+        compared += 4 * n;
+    }
+    std::printf("lane loops: %d values equal in both forms\n", compared);
+}
+#endif
 
 }  // namespace
 }  // namespace atmos

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "atmos/error.h"
+#include "base/cpu_features.h"
 #include "base/library_progress.h"
 #include "base/parallel.h"
 #include "base/progress.h"
@@ -525,25 +526,17 @@ void PhaseSumsPortable(const float* l, int pairs, const float* p2, const float* 
                        float* am) {
     PhaseSumsBody<kTwo, 2>(l, pairs, p2, q2, ar, am);
 }
-#if defined(__x86_64__) && defined(__GNUC__)
+#if ATMOS_HOST_AVX512_DISPATCH
 template <bool kTwo>
 __attribute__((target("avx512f"))) void PhaseSumsAvx512(const float* l, int pairs, const float* p2,
                                                         const float* q2, float* ar, float* am) {
     PhaseSumsBody<kTwo, 4>(l, pairs, p2, q2, ar, am);
 }
-bool UseAvx512() {
-    static const bool use = [] {
-        const char* v = std::getenv("ATMOS_WIDE_AVX512");
-        if (v && std::strcmp(v, "0") == 0) return false;
-        return __builtin_cpu_supports("avx512f") != 0;
-    }();
-    return use;
-}
 #endif
 template <bool kTwo>
 void PhaseSums(const float* l, int pairs, const float* p2, const float* q2, float* ar, float* am) {
-#if defined(__x86_64__) && defined(__GNUC__)
-    if (UseAvx512()) {
+#if ATMOS_HOST_AVX512_DISPATCH
+    if (HostUsesAvx512()) {
         PhaseSumsAvx512<kTwo>(l, pairs, p2, q2, ar, am);
         return;
     }

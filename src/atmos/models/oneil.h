@@ -113,25 +113,33 @@ struct OneilRayStart {
 };
 
 // x[i] = SafeExp(x[i]) (physics/analytic_optical_depth.h) on ExpLane.
-ATMOS_HD ATMOS_LANE_LOOP inline void OneilSafeExpLanes(double* __restrict__ x, int n) {
-    ATMOS_SIMD
+template <int L>
+ATMOS_HD ATMOS_LANE_BODY void OneilSafeExpLanesBody(double* __restrict__ x, int n) {
+    ATMOS_SIMD_LEN(L)
     for (int i = 0; i < n; ++i) x[i] = ExpLane(Clamp(x[i], -700.0, 60.0));
 }
+ATMOS_DEFINE_LANE_LOOP(OneilSafeExpLanes, (double* __restrict__ x, int n), (x, n))
 // One sample of n channels: the attenuation exp(-(a l_r + b l_m)) per
 // channel (a, b: the Rayleigh scattering and Mie extinction coefficients)
 // into the two sums.
-ATMOS_HD ATMOS_LANE_LOOP inline void OneilAttenuateLanes(const double* __restrict__ a,
-                                                         const double* __restrict__ b, int n,
-                                                         double l_r, double l_m, double w_r,
-                                                         double w_m, double* __restrict__ sum_r,
-                                                         double* __restrict__ sum_m) {
-    ATMOS_SIMD
+template <int L>
+ATMOS_HD ATMOS_LANE_BODY void OneilAttenuateLanesBody(const double* __restrict__ a,
+                                                      const double* __restrict__ b, int n,
+                                                      double l_r, double l_m, double w_r,
+                                                      double w_m, double* __restrict__ sum_r,
+                                                      double* __restrict__ sum_m) {
+    ATMOS_SIMD_LEN(L)
     for (int c = 0; c < n; ++c) {
         const double att = ExpLane(-(a[c] * l_r + b[c] * l_m));
         sum_r[c] += att * w_r;
         sum_m[c] += att * w_m;
     }
 }
+ATMOS_DEFINE_LANE_LOOP(OneilAttenuateLanes,
+                       (const double* __restrict__ a, const double* __restrict__ b, int n,
+                        double l_r, double l_m, double w_r, double w_m, double* __restrict__ sum_r,
+                        double* __restrict__ sum_m),
+                       (a, b, n, l_r, l_m, w_r, w_m, sum_r, sum_m))
 
 struct OneilEvaluator : AnalyticEvaluator<OneilEvaluator, OneilOptics> {
     int steps = 5;

@@ -26,6 +26,8 @@
 #if defined(ATMOS_OPENMP_SIMD) && !defined(__CUDACC__)
 #define ATMOS_PRAGMA(x) _Pragma(#x)
 #define ATMOS_SIMD ATMOS_PRAGMA(omp simd simdlen(4))
+// simdlen(L): a loop whose vector length its caller picks (models/lane_loops.h).
+#define ATMOS_SIMD_LEN(L) ATMOS_PRAGMA(omp simd simdlen(L))
 #define ATMOS_SIMD_SUM3(a, b, c) ATMOS_PRAGMA(omp simd reduction(+ : a, b, c))
 // No simdlen: the compiler's widest vectors (loops mixing float and double
 // then run 8 lanes on AVX2, where simdlen(4) gives pairs of 16-byte halves).
@@ -33,6 +35,7 @@
 #else
 #define ATMOS_SIMD_WIDE
 #define ATMOS_SIMD
+#define ATMOS_SIMD_LEN(L)
 #define ATMOS_SIMD_SUM3(a, b, c)
 #endif
 
