@@ -273,6 +273,23 @@ TEST(WideChannelBatches, RefusesBatchesThatDifferBeyondTheirCoefficients) {
         CreateModel("bruneton", {{"mie-storage", "combined"}})->Info().capabilities.wide_channels);
 }
 
+// Every model with wide channel batches refuses to render or sample them
+// before its PrepareWide(), with an atmos::Error (not a crash or zeros).
+TEST(WideChannelBatches, RenderAndSampleBeforePrepareWideThrow) {
+    const AtmosphereParameters atm = EarthAtmosphere();
+    const RenderRequest request = atmos_test::QuietRequest(GetView("ground-noon", atm), 8, 4);
+    const std::vector<SampleQuery> queries = {{0.0, 0.5, 0.2, 60.0}};
+    for (const char* name : {"bruneton", "naive", "hillaire", "atmosphere-plus", "oneil", "schuler",
+                             "flat", "raymarched"}) {
+        SCOPED_TRACE(name);
+        std::unique_ptr<Model> model = CreateModel(name);
+        ASSERT_TRUE(model->Info().capabilities.wide_channels);
+        std::vector<float> values;
+        EXPECT_THROW(model->RenderWide(request, &values), Error);
+        EXPECT_THROW((void)model->SampleWide(queries), Error);
+    }
+}
+
 // The cost study behind docs/performance.md "Wide channel batches" (slow: run
 // by name, `--gtest_also_run_disabled_tests --gtest_filter='*DISABLED_Cost*'`;
 // ATMOS_WIDE_COST_MODEL picks the model, default bruneton:orders=1, whose

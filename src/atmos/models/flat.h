@@ -227,10 +227,7 @@ class FlatModel : public SimpleEvaluatorModel<FlatModel, FlatEvaluator> {
     std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
 
   private:
-    bool wide_prepared_ = false;
-    FlatWideEvaluator wide_;
-    AtmosphereParameters wide_atmosphere_;  // batch 0's (the common fields)
-    WideCoefficients wide_solar_;           // the batches' coefficients (solar irradiance)
+    PreparedWide<FlatWideEvaluator> wide_;
 };
 
 }  // namespace atmos

@@ -75,37 +75,35 @@ void OneilModel::PrepareWide(const std::vector<AtmosphereParameters>& batches,
     // No tables: each batch's Prepare() is its scale() fit and coefficients,
     // made here. The batches share everything but the coefficients
     // (MakeWideCoefficients checks), so the fits are batch 0's.
-    const WideCoefficients coefficients = MakeWideCoefficients(batches);
+    wide_ = PreparedWide<OneilWideEvaluator>();
+    wide_.coefficients = MakeWideCoefficients(batches);
     for (const AtmosphereParameters& a : batches) WarnOutsideValidityDomain(Info(), a);
-    wide_ = OneilWideEvaluator();
-    wide_.narrow = evaluator_;
-    wide_.narrow.optics = MakeOneilOptics(batches[0], refit_);
-    wide_.channels = static_cast<int>(batches.size()) * 3;
+    OneilWideEvaluator& e = wide_.evaluator;
+    e.narrow = evaluator_;
+    e.narrow.optics = MakeOneilOptics(batches[0], refit_);
+    e.channels = static_cast<int>(batches.size()) * 3;
     for (size_t b = 0; b < batches.size(); ++b) {
         // MakeOneilOptics's coefficients (its fit changes only scale() and
         // the heights, common to the batches).
         const AnalyticMedia m = MakeAnalyticMedia(batches[b]);
         for (int c = 0; c < 3; ++c) {
             const size_t k = 3 * b + static_cast<size_t>(c);
-            wide_.rayleigh_scattering[k] = m.rayleigh_scattering[c];
-            wide_.mie_scattering[k] = m.mie_scattering[c];
-            wide_.mie_extinction[k] = m.mie_extinction[c];
-            wide_.ground_albedo[k] = m.ground_albedo[c];
+            e.rayleigh_scattering[k] = m.rayleigh_scattering[c];
+            e.mie_scattering[k] = m.mie_scattering[c];
+            e.mie_extinction[k] = m.mie_extinction[c];
+            e.ground_albedo[k] = m.ground_albedo[c];
         }
     }
-    wide_atmosphere_ = batches[0];
-    wide_solar_ = coefficients;
-    wide_prepared_ = true;
+    wide_.atmosphere = batches[0];
+    wide_.prepared = true;
 }
 
 void OneilModel::RenderWide(const RenderRequest& request, std::vector<float>* values) const {
-    if (!wide_prepared_) Fail("model oneil: PrepareWide() must run before RenderWide()");
-    RenderWideImage(wide_, MakeWidePixelSetup(request, wide_atmosphere_, wide_solar_), values);
+    RenderPreparedWide("oneil", wide_, request, values);
 }
 
 std::vector<float> OneilModel::SampleWide(const std::vector<SampleQuery>& queries) const {
-    if (!wide_prepared_) Fail("model oneil: PrepareWide() must run before SampleWide()");
-    return SampleAllWide(wide_, wide_atmosphere_.bottom_radius, queries);
+    return SamplePreparedWide("oneil", wide_, queries);
 }
 
 }  // namespace atmos

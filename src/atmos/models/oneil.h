@@ -452,10 +452,7 @@ class OneilModel : public SimpleEvaluatorModel<OneilModel, OneilEvaluator> {
 
   private:
     bool refit_ = true;
-    bool wide_prepared_ = false;
-    OneilWideEvaluator wide_;
-    AtmosphereParameters wide_atmosphere_;  // batch 0's (the common fields)
-    WideCoefficients wide_solar_;           // the batches' coefficients (solar irradiance)
+    PreparedWide<OneilWideEvaluator> wide_;
 };
 
 }  // namespace atmos

@@ -39,23 +39,21 @@ void RaymarchedModel::Prepare(const AtmosphereParameters& atmosphere) {
 void RaymarchedModel::PrepareWide(const std::vector<AtmosphereParameters>& batches,
                                   const BatchPrepare&) {
     // No tables: each batch's Prepare() is its AnalyticMedia, made here.
-    wide_solar_ = MakeWideCoefficients(batches);
+    wide_ = PreparedWide<RaymarchedWideEvaluator>();
+    wide_.coefficients = MakeWideCoefficients(batches);
     for (const AtmosphereParameters& a : batches) WarnOutsideValidityDomain(Info(), a);
-    wide_ = RaymarchedWideEvaluator();
-    wide_.steps = evaluator_.steps;
-    wide_.w = MakeFlatWideMedia(batches);
-    wide_atmosphere_ = batches[0];
-    wide_prepared_ = true;
+    wide_.evaluator.steps = evaluator_.steps;
+    wide_.evaluator.w = MakeFlatWideMedia(batches);
+    wide_.atmosphere = batches[0];
+    wide_.prepared = true;
 }
 
 void RaymarchedModel::RenderWide(const RenderRequest& request, std::vector<float>* values) const {
-    if (!wide_prepared_) Fail("model raymarched: PrepareWide() must run before RenderWide()");
-    RenderWideImage(wide_, MakeWidePixelSetup(request, wide_atmosphere_, wide_solar_), values);
+    RenderPreparedWide("raymarched", wide_, request, values);
 }
 
 std::vector<float> RaymarchedModel::SampleWide(const std::vector<SampleQuery>& queries) const {
-    if (!wide_prepared_) Fail("model raymarched: PrepareWide() must run before SampleWide()");
-    return SampleAllWide(wide_, wide_atmosphere_.bottom_radius, queries);
+    return SamplePreparedWide("raymarched", wide_, queries);
 }
 
 }  // namespace atmos

@@ -162,10 +162,7 @@ class RaymarchedModel : public SimpleEvaluatorModel<RaymarchedModel, RaymarchedE
     std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
 
   private:
-    bool wide_prepared_ = false;
-    RaymarchedWideEvaluator wide_;
-    AtmosphereParameters wide_atmosphere_;  // batch 0's (the common fields)
-    WideCoefficients wide_solar_;           // the batches' coefficients (solar irradiance)
+    PreparedWide<RaymarchedWideEvaluator> wide_;
 };
 
 }  // namespace atmos

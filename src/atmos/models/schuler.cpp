@@ -56,29 +56,30 @@ void SchulerModel::PrepareWide(const std::vector<AtmosphereParameters>& batches,
     // (MakeWideCoefficients checks).
     const WideCoefficients coefficients = MakeWideCoefficients(batches);
     for (const AtmosphereParameters& a : batches) WarnOutsideValidityDomain(Info(), a);
-    wide_ = SchulerWideEvaluator();
-    wide_.narrow = evaluator_;
-    wide_.narrow.atm = batches[0];
-    wide_.narrow.m = MakeAnalyticMedia(batches[0]);
-    wide_.w = coefficients;
+    wide_ = PreparedWide<SchulerWideEvaluator>();
+    SchulerWideEvaluator& e = wide_.evaluator;
+    e.narrow = evaluator_;
+    e.narrow.atm = batches[0];
+    e.narrow.m = MakeAnalyticMedia(batches[0]);
+    e.w = coefficients;
     for (size_t b = 0; b < batches.size(); ++b) {
         const AnalyticMedia m = MakeAnalyticMedia(batches[b]);
         for (int c = 0; c < 3; ++c) {
-            wide_.light_rayleigh[3 * b + static_cast<size_t>(c)] = m.rayleigh_scattering[c];
-            wide_.light_mie[3 * b + static_cast<size_t>(c)] = m.mie_extinction[c];
+            e.light_rayleigh[3 * b + static_cast<size_t>(c)] = m.rayleigh_scattering[c];
+            e.light_mie[3 * b + static_cast<size_t>(c)] = m.mie_extinction[c];
         }
     }
-    wide_prepared_ = true;
+    wide_.atmosphere = batches[0];
+    wide_.coefficients = coefficients;
+    wide_.prepared = true;
 }
 
 void SchulerModel::RenderWide(const RenderRequest& request, std::vector<float>* values) const {
-    if (!wide_prepared_) Fail("model schuler: PrepareWide() must run before RenderWide()");
-    RenderWideImage(wide_, MakeWidePixelSetup(request, wide_.narrow.atm, wide_.w), values);
+    RenderPreparedWide("schuler", wide_, request, values);
 }
 
 std::vector<float> SchulerModel::SampleWide(const std::vector<SampleQuery>& queries) const {
-    if (!wide_prepared_) Fail("model schuler: PrepareWide() must run before SampleWide()");
-    return SampleAllWide(wide_, wide_.narrow.atm.bottom_radius, queries);
+    return SamplePreparedWide("schuler", wide_, queries);
 }
 
 }  // namespace atmos

@@ -224,8 +224,7 @@ class SchulerModel : public SimpleEvaluatorModel<SchulerModel, SchulerEvaluator>
     std::vector<float> SampleWide(const std::vector<SampleQuery>& queries) const override;
 
   private:
-    bool wide_prepared_ = false;
-    SchulerWideEvaluator wide_;
+    PreparedWide<SchulerWideEvaluator> wide_;
 };
 
 }  // namespace atmos

@@ -101,4 +101,16 @@ ATMOS_HD inline void WideSampleBilinear(const TableView& t, double u, double v, 
                  x, y.f, out);
 }
 
+// What PrepareWide leaves in a model without tables: its wide evaluator,
+// batch 0's atmosphere (the common fields) and the batches' coefficients (the
+// solar irradiance the pixels take). RenderPreparedWide / SamplePreparedWide
+// (render/wide.h) render and sample it.
+template <typename Evaluator>
+struct PreparedWide {
+    bool prepared = false;
+    Evaluator evaluator;
+    AtmosphereParameters atmosphere;
+    WideCoefficients coefficients;
+};
+
 }  // namespace atmos

@@ -114,4 +114,19 @@ std::vector<float> SampleAllWide(const Evaluator& evaluator, double bottom_radiu
     return out;
 }
 
+// RenderWide and SampleWide of a model's PreparedWide; an atmos::Error naming
+// `model` before its PrepareWide().
+template <typename Evaluator>
+void RenderPreparedWide(const char* model, const PreparedWide<Evaluator>& p,
+                        const RenderRequest& request, std::vector<float>* values) {
+    if (!p.prepared) Fail("model ", model, ": PrepareWide() must run before RenderWide()");
+    RenderWideImage(p.evaluator, MakeWidePixelSetup(request, p.atmosphere, p.coefficients), values);
+}
+template <typename Evaluator>
+std::vector<float> SamplePreparedWide(const char* model, const PreparedWide<Evaluator>& p,
+                                      const std::vector<SampleQuery>& queries) {
+    if (!p.prepared) Fail("model ", model, ": PrepareWide() must run before SampleWide()");
+    return SampleAllWide(p.evaluator, p.atmosphere.bottom_radius, queries);
+}
+
 }  // namespace atmos
