@@ -1,9 +1,11 @@
 // Tests of LUT sampling and table files.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <random>
+#include <string>
 
 #include "atmos/error.h"
 #include "base/texture.h"
@@ -11,6 +13,26 @@
 
 namespace atmos {
 namespace {
+
+// Table storage (base/table_storage.h): zeroed on Resize, aligned to 64 bytes,
+// and from 8 MiB on (Linux) to 2 MiB, the storage advised for huge pages; a
+// copy holds the same values in its own storage.
+TEST(Texture, TableStorageIsZeroedAlignedAndCopied) {
+    Table small(16, 16, 1, 4);
+    EXPECT_EQ(reinterpret_cast<uintptr_t>(small.data()) % 64, 0u);
+    Table large(1024, 1024, 1, 3);  // 12 MiB
+#if defined(__linux__)
+    const char* off = std::getenv("ATMOS_HUGE_PAGES");
+    if (!(off && std::string(off) == "0")) {
+        EXPECT_EQ(reinterpret_cast<uintptr_t>(large.data()) % (uintptr_t{2} << 20), 0u);
+    }
+#endif
+    for (size_t i = 0; i < large.size(); i += 4099) ASSERT_EQ(large.data()[i], 0.0f) << i;
+    large.data()[large.size() - 1] = 7.0f;
+    const Table copy = large;
+    EXPECT_NE(copy.data(), large.data());
+    EXPECT_EQ(copy.data()[copy.size() - 1], 7.0f);
+}
 
 TEST(Texture, UnitRangeMappingRoundTripsAndHitsTexelCentres) {
     for (int n : {2, 8, 256}) {

@@ -22,9 +22,8 @@ bool HugePagesEnabled() {
     return enabled;
 }
 
-}  // namespace
-
-bool TableStorageUsesHugePages(size_t bytes) {
+// Whether storage of `bytes` bytes is advised for huge pages.
+bool UsesHugePages(size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
     return bytes >= kHugeThreshold && HugePagesEnabled();
 #else
@@ -33,10 +32,12 @@ bool TableStorageUsesHugePages(size_t bytes) {
 #endif
 }
 
+}  // namespace
+
 void* AllocateTableStorage(size_t bytes) {
     if (bytes == 0) bytes = 1;
     void* p = nullptr;
-    if (TableStorageUsesHugePages(bytes)) {
+    if (UsesHugePages(bytes)) {
         const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
         if (posix_memalign(&p, kHugePage, rounded) != 0) throw std::bad_alloc();
 #if defined(__linux__) && defined(MADV_HUGEPAGE)

@@ -20,8 +20,6 @@ namespace atmos {
 // for huge pages when large); throws std::bad_alloc.
 void* AllocateTableStorage(size_t bytes);
 void FreeTableStorage(void* p) noexcept;
-// Whether storage of `bytes` bytes would be advised for huge pages.
-bool TableStorageUsesHugePages(size_t bytes);
 
 // std::allocator's interface over AllocateTableStorage.
 template <typename T>
