@@ -40,7 +40,8 @@
 // solar irradiance. The horizon handling: see docs/models/bruneton.md ("bruneton:
 // horizon"). Low sun over the ground (mu_s < 0.01): single Mie integrated along
 // the segment (`low-sun-mie=integrate`, 64 midpoint samples, the exponential in
-// float, within 2 ulp) in place of the seed's smoothstep fade (issue 15).
+// float, within 2 ulp; samples in the planet's shadow add exactly 0 and are
+// skipped) in place of the seed's smoothstep fade (issue 15).
 // Spectral runs: one precomputation and one lookup per ray for every channel
 // of up to 16 batches (bruneton_wide.h, bruneton_wide_precompute.cpp), the
 // batches' tables and values bit for bit.

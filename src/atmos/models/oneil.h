@@ -49,7 +49,9 @@
 // (no vertex interpolation), in double.
 // Wide channel batches (up to 16 batches of three in one model):
 // OneilWideEvaluator below, the geometry once per ray, bit for bit the batches'
-// values; the exponentials of both forms run as ExpLane vector loops.
+// values; the exponentials of both forms run as ExpLane vector loops
+// (models/lane_loops.h: 8-double AVX-512 forms for 16 or more values where the
+// CPU has them, the same bits).
 #pragma once
 
 #include <vector>
